@@ -1,0 +1,3 @@
+use super::*;
+#[derive(Debug, Clone)]
+pub struct Plane;

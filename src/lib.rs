@@ -1,0 +1,18 @@
+//! tribo: implicit quasi-static finite-element simulation of frictional contact between a
+//! deformable sheet and rigid curved tools, scripted in Rhai.
+//!
+//! Layers, each knowing only those below it (see DESIGN.md):
+//! `geometry` -> `contact` -> `tool` -> `mesh`/`material`/`element` -> `solver` -> `output` -> `script`.
+
+pub mod contact;
+pub mod element;
+pub mod error;
+pub mod geometry;
+pub mod material;
+pub mod mesh;
+pub mod output;
+pub mod script;
+pub mod solver;
+pub mod tool;
+
+pub use error::{Error, Result};

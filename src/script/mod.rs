@@ -1,0 +1,1 @@
+//! script (see DESIGN.md).
