@@ -1,1 +1,4 @@
-//! solver (see DESIGN.md).
+//! Sparse assembly, linear solves, Newton iteration and incremental stepping.
+
+pub mod linear;
+pub mod sparse;
