@@ -1,1 +1,156 @@
-//! element (see DESIGN.md).
+//! Finite elements: the [`Element`] interface and the 8-node hexahedron [`Hex8`] with
+//! selective reduced integration (B-bar).
+//!
+//! An element maps nodal displacements to the internal force vector and its tangent
+//!
+//! ```text
+//! f_int = ∫ Bᵀ σ dV,        K = ∂f_int/∂u = ∫ Bᵀ D B dV   (small strain),
+//! ```
+//!
+//! calling the [`Material`] at each integration point. Degrees of freedom are numbered
+//! node by node, `[u0x, u0y, u0z, u1x, ...]`, nodes in the element's connectivity order.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::geometry::Vec3;
+use crate::material::{Material, PointState, Voigt};
+use crate::mesh::Mesh;
+use crate::{Error, Result};
+
+pub mod hex8;
+
+pub use hex8::Hex8;
+
+/// Internal force and tangent stiffness of one element with `D` degrees of freedom
+/// (`D = 3 x nodes`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ElementResponse<const D: usize> {
+    /// Internal force vector `f_int = ∫ Bᵀ σ dV`.
+    pub force: SVector<f64, D>,
+    /// Tangent stiffness `K = ∂f_int/∂u` (symmetric when the material tangent is).
+    pub stiffness: SMatrix<f64, D, D>,
+}
+
+/// A finite element with `D` degrees of freedom (3 per node).
+///
+/// Every method takes the *reference* nodal coordinates, and `evaluate` the *total*
+/// displacement from the reference configuration as well, so that a finite-strain
+/// (total or updated Lagrangian) element can implement the same interface: the current
+/// coordinates are `ref_coords + u`.
+///
+/// Errors never carry the element index (the element does not know it): the caller adds
+/// it with [`in_element`].
+pub trait Element<const D: usize>: std::fmt::Debug + Send + Sync {
+    /// Number of nodes (`D / 3`).
+    fn node_count(&self) -> usize;
+
+    /// Number of integration points, i.e. of [`PointState`]s per element.
+    fn point_count(&self) -> usize;
+
+    /// Internal force and tangent for the displacements `u` (one per node).
+    ///
+    /// `committed` are the converged states of the integration points, `trial` receives
+    /// the states for `u` (see [`Material::update`]); both have
+    /// [`point_count`](Self::point_count) entries. Errors: wrong slice lengths, a
+    /// non-positive Jacobian determinant at an integration point (inverted element), a
+    /// failed material update.
+    fn evaluate(
+        &self,
+        ref_coords: &[Vec3],
+        u: &[Vec3],
+        committed: &[PointState],
+        trial: &mut [PointState],
+        material: &dyn Material,
+    ) -> Result<ElementResponse<D>>;
+
+    /// Volume of the element (reference configuration).
+    fn volume(&self, ref_coords: &[Vec3]) -> Result<f64>;
+
+    /// Volume average of the integration-point stresses, `(1/V) ∫ σ dV` evaluated with the
+    /// element's quadrature: one stress per element for output.
+    fn average_stress(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<Voigt>;
+
+    /// Elastic strain energy stored in the element, `∫ ψ dV` with
+    /// `ψ = material.elastic_energy_density(state)`. For a linear elastic material and
+    /// zero initial state this is `½ uᵀ K u`.
+    fn strain_energy(
+        &self,
+        ref_coords: &[Vec3],
+        states: &[PointState],
+        material: &dyn Material,
+    ) -> Result<f64>;
+}
+
+/// Prefixes the message of `err` with "element {index}: " so that a caller looping over
+/// elements reports which one failed (I/O errors are returned unchanged).
+pub fn in_element(err: Error, index: usize) -> Error {
+    prefix(err, &format!("element {index}"))
+}
+
+/// Prefixes `err`'s message with `what: `.
+pub(crate) fn prefix(err: Error, what: &str) -> Error {
+    match err {
+        Error::Input(m) => Error::Input(format!("{what}: {m}")),
+        Error::Script(m) => Error::Script(format!("{what}: {m}")),
+        Error::LinearSolver(m) => Error::LinearSolver(format!("{what}: {m}")),
+        Error::NoConvergence(m) => Error::NoConvergence(format!("{what}: {m}")),
+        other => other,
+    }
+}
+
+/// The volume-averaged stress of every element of `mesh`, for output. `states` holds the
+/// integration-point states element by element (`point_count` per element, in the
+/// element's point order). Errors name the element.
+pub fn element_average_stresses<const D: usize, E: Element<D> + ?Sized>(
+    mesh: &Mesh,
+    element: &E,
+    states: &[PointState],
+) -> Result<Vec<Voigt>> {
+    let np = check_state_count(mesh, element.point_count(), states)?;
+    (0..mesh.element_count())
+        .map(|e| {
+            element
+                .average_stress(&mesh.hex_coordinates(e), &states[e * np..(e + 1) * np])
+                .map_err(|err| in_element(err, e))
+        })
+        .collect()
+}
+
+/// Total elastic strain energy of the mesh (sum of [`Element::strain_energy`]), with the
+/// states laid out as in [`element_average_stresses`].
+pub fn total_strain_energy<const D: usize, E: Element<D> + ?Sized>(
+    mesh: &Mesh,
+    element: &E,
+    states: &[PointState],
+    material: &dyn Material,
+) -> Result<f64> {
+    let np = check_state_count(mesh, element.point_count(), states)?;
+    (0..mesh.element_count()).try_fold(0.0, |sum, e| {
+        element
+            .strain_energy(
+                &mesh.hex_coordinates(e),
+                &states[e * np..(e + 1) * np],
+                material,
+            )
+            .map(|w| sum + w)
+            .map_err(|err| in_element(err, e))
+    })
+}
+
+/// Checks `states.len() == elements x points` (and the indices of the mesh) and returns
+/// the number of points per element.
+fn check_state_count(mesh: &Mesh, points: usize, states: &[PointState]) -> Result<usize> {
+    mesh.validate()?;
+    let expected = mesh.element_count() * points;
+    if states.len() != expected {
+        return Err(Error::input(
+            "number of integration-point states",
+            states.len(),
+            &format!(
+                "must be {expected} ({} elements x {points} points)",
+                mesh.element_count()
+            ),
+        ));
+    }
+    Ok(points)
+}

@@ -1,1 +1,242 @@
-//! material (see DESIGN.md).
+//! Constitutive models: the [`Material`] trait, the per-integration-point state
+//! [`PointState`], the kinematic input [`Kinematics`] and Voigt-notation helpers.
+//!
+//! # Voigt convention
+//!
+//! Symmetric second-order tensors are stored as 6-vectors in the order
+//! `[xx, yy, zz, xy, yz, zx]`:
+//!
+//! * stress-like tensors with their tensor components,
+//!   `σ = [σxx, σyy, σzz, σxy, σyz, σzx]`;
+//! * strain-like tensors with *engineering* shear components,
+//!   `ε = [εxx, εyy, εzz, γxy, γyz, γzx]` with `γxy = 2 εxy`.
+//!
+//! Why: with this pairing the plain dot product of the two vectors is the double
+//! contraction, `σ·ε = σ : ε` (the work density), so `f_int = ∫ Bᵀσ dV` and the energy
+//! `½ σ·ε` need no factors of 2, and a tangent `D = ∂σ/∂ε` is a symmetric 6x6 matrix
+//! whenever the 4th-order tangent has major symmetry.
+//!
+//! # How a material is called
+//!
+//! Each integration point carries a *committed* state (converged at the end of the last
+//! load step) and a *trial* state (the current Newton iterate). For each iterate the
+//! element computes the [`Kinematics`] at the point and calls
+//! [`Material::update`]`(kin, committed, trial)`, which computes the full trial state from
+//! the committed one (never from the previous iterate, so Newton iterations do not
+//! accumulate path dependence) and returns the algorithmic tangent. The solver copies
+//! trial into committed when a step converges and discards trial when it is cut back.
+
+use nalgebra::{Matrix6, Vector6};
+
+use crate::geometry::Mat3;
+use crate::Result;
+
+mod linear_elastic;
+
+pub use linear_elastic::LinearElastic;
+
+/// A symmetric tensor in Voigt notation `[xx, yy, zz, xy, yz, zx]`; see the module
+/// documentation for the stress / strain (engineering shear) convention.
+pub type Voigt = Vector6<f64>;
+
+/// A 6x6 material tangent in Voigt notation, mapping engineering strain to stress.
+pub type Tangent = Matrix6<f64>;
+
+/// The state of a material at one integration point.
+///
+/// All fields are fixed-size so the state is `Copy` and arrays of states need no heap
+/// allocation per point. A material keeps in it whatever history it needs; fields it does
+/// not use are carried over unchanged. Construct with [`PointState::default`] (or
+/// [`Material::initial_state`]) and struct-update syntax, so that fields added for later
+/// materials do not break existing code.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointState {
+    /// Cauchy stress (Voigt, tensor components). Equal to the small-strain stress for
+    /// small-strain materials.
+    pub stress: Voigt,
+    /// Total strain (Voigt, engineering shear): the small strain `sym ∇u` for small-strain
+    /// materials, a logarithmic (Hencky) strain for finite-strain ones.
+    pub strain: Voigt,
+    /// Plastic strain (Voigt, engineering shear); zero for elastic materials.
+    pub plastic_strain: Voigt,
+    /// Equivalent (accumulated) plastic strain, the hardening variable; zero for elastic
+    /// materials.
+    pub eq_plastic_strain: f64,
+    /// Deformation gradient `F = I + ∂u/∂X` at which this state was computed. Stored so
+    /// that a finite-strain material can form the incremental gradient
+    /// `f = F_{n+1} F_n⁻¹` between the committed and the trial state (objective
+    /// stress updates, rotation of anisotropy axes).
+    pub deformation_gradient: Mat3,
+}
+
+impl Default for PointState {
+    /// The virgin state: stress- and strain-free, `F = I`.
+    fn default() -> Self {
+        PointState {
+            stress: Voigt::zeros(),
+            strain: Voigt::zeros(),
+            plastic_strain: Voigt::zeros(),
+            eq_plastic_strain: 0.0,
+            deformation_gradient: Mat3::identity(),
+        }
+    }
+}
+
+/// Kinematic input of a material update at one integration point, at the end of the
+/// current increment (the trial configuration).
+///
+/// Both a small-strain measure and the full deformation gradient are supplied so that the
+/// element interface does not change when a finite-strain material is added: small-strain
+/// materials read `strain`, finite-strain materials read `deformation_gradient` (together
+/// with the committed state's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Kinematics {
+    /// Small strain `ε = sym ∇u` (Voigt, engineering shear), with the element's
+    /// volumetric treatment applied (B-bar: the volumetric part is the element average).
+    pub strain: Voigt,
+    /// Deformation gradient `F = I + ∂u/∂X` (reference gradient, no volumetric
+    /// modification; an F-bar element would pass the modified gradient here).
+    pub deformation_gradient: Mat3,
+}
+
+impl Kinematics {
+    /// Kinematics of a pure small-strain state `ε` (with `F = I + ε` as tensor, i.e.
+    /// without rotation); handy for testing small-strain materials.
+    pub fn from_strain(strain: Voigt) -> Self {
+        Kinematics {
+            strain,
+            deformation_gradient: Mat3::identity() + strain_to_tensor(&strain),
+        }
+    }
+}
+
+/// A constitutive model.
+///
+/// The interface is the same for small-strain elastic and for finite-strain elastoplastic
+/// models (e.g. Hill48 yield with Swift hardening and a return mapping): the history lives
+/// in [`PointState`], the kinematics in [`Kinematics`], and `update` returns the tangent
+/// the element needs.
+pub trait Material: std::fmt::Debug + Send + Sync {
+    /// Computes the trial state at the end of the increment from the `committed` state
+    /// and the kinematics `kin`, writing every field of `trial` (fields the model does not
+    /// use are copied from `committed`), and returns the algorithmic (consistent) tangent
+    /// `D = ∂σ/∂ε` (Voigt, engineering shear strain), which makes Newton's method converge
+    /// quadratically. For finite-strain models the tangent is the spatial one that the
+    /// corresponding finite-strain element expects.
+    ///
+    /// Errors: the update is impossible (e.g. non-finite strain from a diverging Newton
+    /// iterate, or a return mapping that fails); the solver then cuts the step back.
+    fn update(
+        &self,
+        kin: &Kinematics,
+        committed: &PointState,
+        trial: &mut PointState,
+    ) -> Result<Tangent>;
+
+    /// The elastic tangent (initial stiffness), e.g. for a first predictor or a
+    /// stiffness-proportional damping or penalty scale.
+    fn elastic_tangent(&self) -> Tangent;
+
+    /// Stored elastic energy per unit (reference) volume in `state`.
+    fn elastic_energy_density(&self, state: &PointState) -> f64;
+
+    /// The state of a virgin point. Defaults to [`PointState::default`].
+    fn initial_state(&self) -> PointState {
+        PointState::default()
+    }
+
+    /// A short human-readable description ("linear elastic E=210000 nu=0.3") for logs.
+    fn describe(&self) -> String;
+}
+
+/// Strain tensor from a Voigt strain vector with engineering shear (halves the shears).
+pub fn strain_to_tensor(e: &Voigt) -> Mat3 {
+    Mat3::new(
+        e[0],
+        0.5 * e[3],
+        0.5 * e[5],
+        0.5 * e[3],
+        e[1],
+        0.5 * e[4],
+        0.5 * e[5],
+        0.5 * e[4],
+        e[2],
+    )
+}
+
+/// Voigt strain vector (engineering shear, doubles the shears) of the symmetric part of `m`.
+pub fn strain_from_tensor(m: &Mat3) -> Voigt {
+    Voigt::new(
+        m[(0, 0)],
+        m[(1, 1)],
+        m[(2, 2)],
+        m[(0, 1)] + m[(1, 0)],
+        m[(1, 2)] + m[(2, 1)],
+        m[(2, 0)] + m[(0, 2)],
+    )
+}
+
+/// Stress tensor from a Voigt stress vector (tensor components).
+pub fn stress_to_tensor(s: &Voigt) -> Mat3 {
+    Mat3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2])
+}
+
+/// Voigt stress vector (tensor components) of the symmetric part of `m`.
+pub fn stress_from_tensor(m: &Mat3) -> Voigt {
+    Voigt::new(
+        m[(0, 0)],
+        m[(1, 1)],
+        m[(2, 2)],
+        0.5 * (m[(0, 1)] + m[(1, 0)]),
+        0.5 * (m[(1, 2)] + m[(2, 1)]),
+        0.5 * (m[(2, 0)] + m[(0, 2)]),
+    )
+}
+
+/// Von Mises equivalent stress `sqrt(3/2 s:s)` of a Voigt stress, `s` its deviator.
+pub fn von_mises(s: &Voigt) -> f64 {
+    let (a, b, c) = (s[0] - s[1], s[1] - s[2], s[2] - s[0]);
+    (0.5 * (a * a + b * b + c * c) + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5])).sqrt()
+}
+
+/// Pressure `-tr(σ)/3` of a Voigt stress (positive in compression).
+pub fn pressure(s: &Voigt) -> f64 {
+    -(s[0] + s[1] + s[2]) / 3.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn voigt_round_trips_and_double_contraction() {
+        let e = Voigt::new(1.0, 2.0, 3.0, 0.4, 0.6, 0.8);
+        let s = Voigt::new(5.0, -1.0, 2.0, 0.3, -0.7, 1.1);
+        assert_eq!(strain_from_tensor(&strain_to_tensor(&e)), e);
+        assert_eq!(stress_from_tensor(&stress_to_tensor(&s)), s);
+        // σ·ε (Voigt) = σ : ε (tensors) thanks to engineering shears.
+        let contraction = stress_to_tensor(&s)
+            .component_mul(&strain_to_tensor(&e))
+            .sum();
+        assert!((s.dot(&e) - contraction).abs() < 1e-14);
+    }
+
+    #[test]
+    fn von_mises_and_pressure() {
+        let uniaxial = Voigt::new(7.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        assert!((von_mises(&uniaxial) - 7.0).abs() < 1e-14);
+        let shear = Voigt::new(0.0, 0.0, 0.0, 2.0, 0.0, 0.0);
+        assert!((von_mises(&shear) - 2.0 * 3f64.sqrt()).abs() < 1e-14);
+        let hydro = Voigt::new(-3.0, -3.0, -3.0, 0.0, 0.0, 0.0);
+        assert_eq!(von_mises(&hydro), 0.0);
+        assert_eq!(pressure(&hydro), 3.0);
+    }
+
+    #[test]
+    fn default_state_is_virgin() {
+        let s = PointState::default();
+        assert_eq!(s.stress, Voigt::zeros());
+        assert_eq!(s.deformation_gradient, Mat3::identity());
+        assert_eq!(s.eq_plastic_strain, 0.0);
+    }
+}
