@@ -7,9 +7,14 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+mod check;
 pub mod cylinder;
 pub mod plane;
 pub mod sphere;
+#[cfg(test)]
+pub(crate) mod testutil;
+
+pub(crate) use check::{finite_vec3, fmt_vec3, positive_length, unit_vec3};
 
 pub use cylinder::Cylinder;
 pub use plane::Plane;

@@ -1,1 +1,7 @@
-//! tool (see DESIGN.md).
+//! Rigid tools: a surface, its pose, and how the pose moves with pseudo-time (see DESIGN.md).
+
+pub mod pose;
+pub mod schedule;
+
+pub use pose::{project_posed, Pose};
+pub use schedule::{ScalarSchedule, Schedule};
