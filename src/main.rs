@@ -1,1 +1,80 @@
-fn main() {}
+//! The `tribo` command line: run a process script, or step it in a REPL.
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use tribo::script::{self, HostOptions};
+
+#[derive(Parser)]
+#[command(name = "tribo", version, about = "Implicit frictional contact of a sheet against rigid curved tools, scripted in Rhai")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a process script to its end.
+    Run {
+        /// The .rhai process script.
+        script: PathBuf,
+        /// Output folder (default: out/<script name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a top-level `let NAME = ...;` of the script: --set cells=50 --set variant="benchmark".
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Interactive stepping; loads SCRIPT's scene first if given.
+    Repl {
+        script: Option<PathBuf>,
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+fn default_out(script: Option<&PathBuf>) -> PathBuf {
+    let stem = script
+        .and_then(|p| p.file_stem())
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "repl".into());
+    PathBuf::from("out").join(stem)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run { script, out, set, quiet } => (|| {
+            let overrides = set
+                .iter()
+                .map(|s| script::parse_override(s))
+                .collect::<tribo::Result<Vec<_>>>()?;
+            let host = HostOptions {
+                out_dir: out.unwrap_or_else(|| default_out(Some(&script))),
+                progress: !quiet,
+                ..HostOptions::default()
+            };
+            script::run_file(&script, &overrides, &host)?;
+            eprintln!("results in {}", host.out_dir.display());
+            Ok(())
+        })(),
+        Command::Repl { script, out } => {
+            let host = HostOptions {
+                out_dir: out.unwrap_or_else(|| default_out(script.as_ref())),
+                progress: true,
+                ..HostOptions::default()
+            };
+            script::repl::run(script.as_deref(), &host)
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,5 +1,50 @@
 //! Frictional contact: the nodal Alart-Curnier operator, friction laws and per-node state.
 
+pub mod friction;
 pub mod operator;
+pub mod state;
 
+pub use friction::FrictionLaw;
 pub use operator::{alart_curnier, ContactStatus, NodalContact, OperatorParams};
+pub use state::ContactNodeState;
+
+/// How contact constraints are enforced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Enforcement {
+    /// Mixed (u, lambda) augmented-Lagrangian formulation (Alart-Curnier): exact constraints.
+    #[default]
+    AugmentedLagrangian,
+    /// Plain penalty: normal force r d_n, tangential force r delta_t added to the committed
+    /// tangential force; no multiplier unknowns, the constraint is violated by force/r.
+    Penalty,
+}
+
+/// Where the contact frame (foot point, normal) is evaluated during Newton iterations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FrameUpdate {
+    /// Projected anew at every iteration (the paper's choice: exact on curved tools).
+    #[default]
+    EveryIteration,
+    /// Projected once at the start of the increment and kept (the tool is replaced by its
+    /// tangent plane for the increment).
+    Frozen,
+}
+
+/// Switches of the contact treatment that studies compare.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactSettings {
+    pub enforcement: Enforcement,
+    pub frame: FrameUpdate,
+    /// Include curvature (normal gradient) terms in the Jacobian.
+    pub curvature: bool,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        ContactSettings {
+            enforcement: Enforcement::AugmentedLagrangian,
+            frame: FrameUpdate::EveryIteration,
+            curvature: true,
+        }
+    }
+}

@@ -10,8 +10,8 @@
 //! delta   = x - x_ref,   delta_t = (I - n n^T) delta
 //! g       = d n + delta_t
 //! sigma   = lambda + r g,   sigma_n = sigma . n,   sigma_t = sigma - sigma_n n
-//! gap   (sigma_n >= 0):                    F_equi = 0
-//! stick (|sigma_t| + mu sigma_n < 0):      F_equi = sigma
+//! gap   (sigma_n > 0):                     F_equi = 0
+//! stick (|sigma_t| + mu sigma_n <= 0):     F_equi = sigma
 //! slip  (otherwise):                       F_equi = sigma_n (n - mu t),  t = sigma_t/|sigma_t|
 //! F_suppl = -(lambda - F_equi) / r         (eq. 23, all statuses)
 //! ```
@@ -26,6 +26,10 @@
 //! dt          = (I - t t^T) dsigma_t / |sigma_t|
 //! dF_equi(slip) = (n - mu t) dsigma_n + sigma_n G dx - mu sigma_n dt
 //! ```
+//!
+//! The boundary cases go to contact: a node touching the tool with zero multiplier
+//! (sigma = 0, e.g. a block resting on a plane before it is loaded) sticks, which gives
+//! Newton a non-singular first iteration instead of a free rigid-body mode.
 //!
 //! Every term containing `G` is a curvature term; with `curvature = false` they are dropped
 //! from the Jacobian (the residual keeps the exact geometry), which is what a code without
@@ -117,9 +121,9 @@ pub fn alart_curnier(
     let dsigma_x = a * r;
     let dsigma_n_x = n.transpose() * dsigma_x + sigma.transpose() * g_mat;
 
-    let (status, f_equi, equi_x, equi_lambda) = if sigma_n >= 0.0 {
+    let (status, f_equi, equi_x, equi_lambda) = if sigma_n > 0.0 {
         (ContactStatus::Gap, Vec3::zeros(), Mat3::zeros(), Mat3::zeros())
-    } else if sigma_t.norm() + mu * sigma_n < 0.0 {
+    } else if sigma_t.norm() + mu * sigma_n <= 0.0 {
         (ContactStatus::Stick, sigma, dsigma_x, ident)
     } else {
         let st_norm = sigma_t.norm();

@@ -15,7 +15,10 @@ mod pvd;
 mod summary;
 mod vtk;
 
+pub mod run;
+
 pub use self::csv::HistoryCsv;
+pub use self::run::RunOutput;
 pub use self::folder::OutputFolder;
 pub use self::pvd::{PvdEntry, PvdSeries};
 pub use self::summary::{write_summary, SUMMARY_FILE};

@@ -1,1 +1,229 @@
-//! script (see DESIGN.md).
+//! Rhai bindings: the engine that runs process scripts, and the REPL.
+//!
+//! Everything scripts can see is registered here (one module per group of types); nothing
+//! below this module knows that Rhai exists. Scripts run sandboxed: operation, call-depth
+//! and size limits, and output only below the run's output folder.
+
+mod api_scene;
+mod api_sim;
+mod convert;
+pub mod repl;
+mod stdlib;
+
+pub use api_sim::ScriptSim;
+
+use crate::{Error, Result};
+use rhai::{Dynamic, Engine, EvalAltResult, Position, Scope, AST};
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+
+/// How the host runs scripts.
+#[derive(Clone, Debug)]
+pub struct HostOptions {
+    /// The run's output folder (VTK frames, history.csv, summary.json).
+    pub out_dir: PathBuf,
+    /// Show a progress bar during `sim.run()`.
+    pub progress: bool,
+    /// Maximum number of script operations (an endless loop stops with an error).
+    pub max_operations: u64,
+    /// While set (the REPL loading its script), `sim.run()` returns at once so that the
+    /// person can step the scene by hand.
+    pub defer_run: Rc<std::cell::Cell<bool>>,
+}
+
+impl Default for HostOptions {
+    fn default() -> Self {
+        HostOptions {
+            out_dir: PathBuf::from("out"),
+            progress: false,
+            max_operations: 50_000_000,
+            defer_run: Rc::new(std::cell::Cell::new(false)),
+        }
+    }
+}
+
+/// Builds a sandboxed engine with the tribo API and the std-lib module resolver.
+pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
+    let mut engine = Engine::new();
+    engine.set_max_operations(host.max_operations);
+    engine.set_max_call_levels(64);
+    engine.set_max_expr_depths(128, 64);
+    engine.set_max_string_size(1 << 20);
+    engine.set_max_array_size(1 << 22);
+    engine.set_max_map_size(1 << 16);
+    engine.set_module_resolver(stdlib::resolver(script_dir));
+    let host = Rc::new(host.clone());
+    api_scene::register(&mut engine);
+    api_sim::register(&mut engine, host);
+    register_checks(&mut engine);
+    engine
+}
+
+/// Assertions for scripted test cases: a failed one stops the script with its message.
+fn register_checks(engine: &mut Engine) {
+    engine.register_fn("assert", |cond: bool, msg: &str| -> convert::ScriptResult<()> {
+        if cond {
+            Ok(())
+        } else {
+            Err(Box::new(EvalAltResult::ErrorRuntime(format!("assertion failed: {msg}").into(), Position::NONE)))
+        }
+    });
+    engine.register_fn(
+        "assert_close",
+        |a: f64, b: f64, rel: f64, msg: &str| -> convert::ScriptResult<()> {
+            let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
+            if (a - b).abs() <= rel * scale {
+                Ok(())
+            } else {
+                Err(Box::new(EvalAltResult::ErrorRuntime(
+                    format!("assertion failed: {msg}: {a} and {b} differ by more than {rel} relative").into(),
+                    Position::NONE,
+                )))
+            }
+        },
+    );
+}
+
+/// Formats a Rhai error as "file:line:column: message".
+pub fn describe_error(file: &str, err: &EvalAltResult) -> String {
+    let pos = innermost_position(err);
+    let msg = err.to_string();
+    match (pos.line(), pos.position()) {
+        (Some(l), Some(c)) => format!("{file}:{l}:{c}: {msg}"),
+        (Some(l), None) => format!("{file}:{l}: {msg}"),
+        _ => format!("{file}: {msg}"),
+    }
+}
+
+fn innermost_position(err: &EvalAltResult) -> Position {
+    match err {
+        EvalAltResult::ErrorInFunctionCall(_, _, inner, pos) | EvalAltResult::ErrorInModule(_, inner, pos) => {
+            let p = innermost_position(inner);
+            if p.is_none() {
+                *pos
+            } else if inner_is_other_source(inner) {
+                *pos
+            } else {
+                p
+            }
+        }
+        other => other.position(),
+    }
+}
+
+/// An error raised inside a function of another source (a std-lib module) keeps the caller's
+/// position in this file.
+fn inner_is_other_source(err: &EvalAltResult) -> bool {
+    matches!(err, EvalAltResult::ErrorInModule(..))
+}
+
+/// Parses a `--set NAME=VALUE` value: integer, float, boolean, else a string.
+pub fn parse_override(text: &str) -> Result<(String, Dynamic)> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| Error::Input(format!("--set '{text}' must have the form NAME=VALUE")))?;
+    let name = name.trim();
+    if name.is_empty() || !name.chars().all(|c| c.is_alphanumeric() || c == '_') {
+        return Err(Error::Input(format!("--set name '{name}' is not a valid variable name")));
+    }
+    let v = value.trim();
+    let dynamic = if let Ok(i) = v.parse::<i64>() {
+        Dynamic::from(i)
+    } else if let Ok(f) = v.parse::<f64>() {
+        Dynamic::from(f)
+    } else if let Ok(b) = v.parse::<bool>() {
+        Dynamic::from(b)
+    } else {
+        Dynamic::from(v.trim_matches('"').to_string())
+    };
+    Ok((name.to_string(), dynamic))
+}
+
+/// Compiles a script file, naming the file in errors.
+pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
+    let source = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let file = path.display().to_string();
+    let mut ast = engine.compile(&source).map_err(|e| {
+        let p = e.position();
+        Error::Script(format!(
+            "{file}:{}:{}: syntax error: {}",
+            p.line().unwrap_or(0),
+            p.position().unwrap_or(0),
+            e.0
+        ))
+    })?;
+    ast.set_source(file);
+    Ok(ast)
+}
+
+/// Runs a script file to its end.
+pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions) -> Result<()> {
+    let engine = engine(host, path.parent());
+    let ast = compile(&engine, path)?;
+    let ast = apply_overrides(&engine, ast, overrides, path)?;
+    let mut scope = Scope::new();
+    engine
+        .run_ast_with_scope(&mut scope, &ast)
+        .map_err(|e| Error::Script(describe_error(&path.display().to_string(), &e)))
+}
+
+/// `--set NAME=VALUE` replaces the value of the script's top-level `let NAME = ...;`
+/// (its default), so one script serves a family of runs. A name the script never declares
+/// is an error (a typo would otherwise be silently ignored).
+pub fn apply_overrides(engine: &Engine, ast: AST, overrides: &[(String, Dynamic)], path: &Path) -> Result<AST> {
+    if overrides.is_empty() {
+        return Ok(ast);
+    }
+    let source = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let mut patched = String::new();
+    let mut seen = vec![false; overrides.len()];
+    for line in source.lines() {
+        let trimmed = line.trim_start();
+        let mut replaced = false;
+        for (i, (name, value)) in overrides.iter().enumerate() {
+            let prefix = format!("let {name} =");
+            if !seen[i] && trimmed.starts_with(&prefix) && !line.starts_with(char::is_whitespace) {
+                let code = line.split("//").next().unwrap_or("").trim_end();
+                if !code.ends_with(';') {
+                    return Err(Error::Input(format!(
+                        "--set {name}: the declaration `{}` in {} must fit on one line ending with ';'",
+                        line.trim(),
+                        path.display()
+                    )));
+                }
+                patched.push_str(&format!("let {name} = {};", literal(value)));
+                seen[i] = true;
+                replaced = true;
+                break;
+            }
+        }
+        if !replaced {
+            patched.push_str(line);
+        }
+        patched.push('\n');
+    }
+    if let Some(i) = seen.iter().position(|s| !s) {
+        return Err(Error::Input(format!(
+            "--set {}: the script {} has no top-level `let {} = ...;` to override",
+            overrides[i].0,
+            path.display(),
+            overrides[i].0
+        )));
+    }
+    let file = path.display().to_string();
+    let mut ast = engine
+        .compile(&patched)
+        .map_err(|e| Error::Script(format!("{file}: after --set: {e}")))?;
+    ast.set_source(file);
+    Ok(ast)
+}
+
+fn literal(v: &Dynamic) -> String {
+    if let Some(s) = v.clone().try_cast::<String>() {
+        format!("{s:?}")
+    } else if let Some(f) = v.clone().try_cast::<f64>() {
+        format!("{f:?}")
+    } else {
+        v.to_string()
+    }
+}

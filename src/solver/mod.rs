@@ -1,4 +1,10 @@
 //! Sparse assembly, linear solves, Newton iteration and incremental stepping.
 
+pub mod assembly;
 pub mod linear;
+pub mod model;
+pub mod simulation;
 pub mod sparse;
+
+pub use model::{Model, SolverSettings};
+pub use simulation::{IncrementReport, IterationRecord, Simulation};

@@ -5,3 +5,6 @@ pub mod schedule;
 
 pub use pose::{project_posed, Pose};
 pub use schedule::{ScalarSchedule, Schedule};
+pub mod rigid_tool;
+
+pub use rigid_tool::Tool;

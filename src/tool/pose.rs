@@ -36,6 +36,11 @@ impl Pose {
         *v
     }
 
+    /// Global direction to the surface frame: `R^T v` (identity rotation for now).
+    pub fn to_local_vector(&self, v: &Vec3) -> Vec3 {
+        *v
+    }
+
     /// Surface-frame tensor to global: `R G R^T`. For the normal gradient this follows from
     /// `n(x) = R n_local(R^T (x - t))`.
     pub fn to_global_matrix(&self, g: &Mat3) -> Mat3 {

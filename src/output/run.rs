@@ -1,0 +1,201 @@
+//! Everything a run writes to its output folder: a VTK frame per output increment with a
+//! .pvd series, history.csv (one row per converged increment) and summary.json.
+//! Files are flushed as they are written, so a run that stops keeps everything so far.
+
+use super::{write_summary, write_vtu, Field, Frame, HistoryCsv, OutputFolder, PvdSeries};
+use crate::contact::ContactStatus;
+use crate::solver::{IncrementReport, Simulation};
+use crate::Result;
+use std::path::Path;
+
+pub struct RunOutput {
+    folder: OutputFolder,
+    pvd: PvdSeries,
+    history: HistoryCsv,
+    frames: usize,
+}
+
+impl RunOutput {
+    pub fn create(dir: &Path, sim: &Simulation) -> Result<Self> {
+        let folder = OutputFolder::create(dir)?;
+        let pvd = PvdSeries::new(folder.root(), "frames")?;
+        let mut columns: Vec<String> = [
+            "increment",
+            "time",
+            "dt",
+            "newton_iterations",
+            "cutbacks",
+            "force_residual_rel",
+            "contact_residual",
+            "active_nodes",
+            "slipping_nodes",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        for c in &sim.model.contacts {
+            for axis in ["x", "y", "z"] {
+                columns.push(format!("{}_force_{axis}", c.tool.name));
+            }
+        }
+        let history = HistoryCsv::create(folder.resolve_for_write("history.csv")?, &columns)?;
+        Ok(RunOutput {
+            folder,
+            pvd,
+            history,
+            frames: 0,
+        })
+    }
+
+    pub fn folder(&self) -> &OutputFolder {
+        &self.folder
+    }
+
+    /// Appends the increment's row to history.csv.
+    pub fn record(&mut self, _sim: &Simulation, r: &IncrementReport) -> Result<()> {
+        let last = r.residuals.last();
+        let mut row = vec![
+            r.index as f64,
+            r.time,
+            r.dt,
+            r.iterations as f64,
+            r.cutbacks as f64,
+            last.map_or(0.0, |x| x.force_rel),
+            last.map_or(0.0, |x| x.contact),
+            r.active_nodes as f64,
+            r.slipping_nodes as f64,
+        ];
+        for f in &r.tool_forces {
+            row.extend_from_slice(f);
+        }
+        self.history.append(&row)
+    }
+
+    /// Writes the committed state as frames/frame_NNNN.vtu and adds it to frames.pvd.
+    pub fn write_frame(&mut self, sim: &Simulation) -> Result<()> {
+        let name = format!("frames/frame_{:04}.vtu", self.frames);
+        let path = self.folder.resolve_for_write(&name)?;
+        write_vtu(&path, &frame(sim))?;
+        self.pvd.add(sim.time(), &name)?;
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// Writes summary.json; `error` records why a run stopped early.
+    pub fn write_summary(&self, sim: &Simulation, wall_time_s: f64, error: Option<&str>) -> Result<()> {
+        let tools: serde_json::Map<String, serde_json::Value> = sim
+            .model
+            .contacts
+            .iter()
+            .enumerate()
+            .map(|(c, contact)| {
+                let f = sim.tool_force(c);
+                (
+                    contact.tool.name.clone(),
+                    serde_json::json!({
+                        "final_force": [f.x, f.y, f.z],
+                        "surface": contact.tool.surface.describe(),
+                        "friction": contact.tool.friction.describe(),
+                        "candidate_nodes": contact.candidates.len(),
+                    }),
+                )
+            })
+            .collect();
+        let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();
+        let settings = &sim.model.settings;
+        let summary = serde_json::json!({
+            "status": if error.is_some() { "stopped" } else if sim.is_finished() { "finished" } else { "running" },
+            "error": error,
+            "time": sim.time(),
+            "end_time": settings.end_time,
+            "increments": sim.history.len(),
+            "newton_iterations": iterations,
+            "cutbacks": sim.history.iter().map(|r| r.cutbacks).sum::<usize>(),
+            "wall_time_s": wall_time_s,
+            "phase_times_s": {
+                "elements": sim.phase_times.elements,
+                "contact": sim.phase_times.contact,
+                "factorization_and_solve": sim.phase_times.factorization_and_solve,
+            },
+            "nodes": sim.model.mesh.nodes.len(),
+            "elements": sim.model.mesh.hexes.len(),
+            "contact": {
+                "enforcement": format!("{:?}", settings.contact.enforcement),
+                "frame": format!("{:?}", settings.contact.frame),
+                "curvature_terms": settings.contact.curvature,
+            },
+            "tools": tools,
+            "frames": self.frames,
+        });
+        write_summary(&self.folder.resolve_for_write("summary.json")?, &summary)
+    }
+}
+
+/// The committed state as a VTK frame: displacement and contact fields on the nodes,
+/// element-averaged stress on the cells. A node touching several tools shows the tool
+/// pressing it hardest.
+pub fn frame(sim: &Simulation) -> Frame {
+    let mesh = &sim.model.mesh;
+    let n = mesh.nodes.len();
+    let u = sim.displacements();
+    let mut status = vec![0.0; n];
+    let mut gap = vec![f64::NAN; n];
+    let mut lambda_n = vec![0.0; n];
+    let mut lambda_t = vec![0.0; n];
+    let mut pressure = vec![0.0; n];
+    let mut work = vec![0.0; n];
+    let mut slip = vec![0.0; n];
+    let mut mu = vec![0.0; n];
+    for (c, contact) in sim.model.contacts.iter().enumerate() {
+        for (k, s) in sim.contact_states(c).iter().enumerate() {
+            let node = contact.candidates[k];
+            let ln = s.lambda_n();
+            let first = gap[node].is_nan();
+            if first || ln < lambda_n[node] || (ln == lambda_n[node] && s.gap < gap[node]) {
+                status[node] = s.status.code();
+                gap[node] = s.gap;
+                lambda_n[node] = ln;
+                lambda_t[node] = s.lambda_t_norm();
+                pressure[node] = if s.status == ContactStatus::Gap { 0.0 } else { -ln / contact.areas[k].max(f64::MIN_POSITIVE) };
+                mu[node] = s.mu;
+            }
+            work[node] += s.work;
+            slip[node] = f64::max(slip[node], s.slip);
+        }
+    }
+    for g in gap.iter_mut().filter(|g| g.is_nan()) {
+        *g = 0.0;
+    }
+    let per = sim.points().len() / mesh.hexes.len().max(1);
+    let mut stress = vec![0.0; 6 * mesh.hexes.len()];
+    let mut von_mises = vec![0.0; mesh.hexes.len()];
+    for e in 0..mesh.hexes.len() {
+        let pts = &sim.points()[e * per..(e + 1) * per];
+        for p in pts {
+            for i in 0..6 {
+                stress[6 * e + i] += p.stress[i] / per as f64;
+            }
+        }
+        let s = &stress[6 * e..6 * e + 6];
+        von_mises[e] = (0.5 * ((s[0] - s[1]).powi(2) + (s[1] - s[2]).powi(2) + (s[2] - s[0]).powi(2))
+            + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]))
+            .sqrt();
+    }
+    // VTK orders symmetric tensors xx, yy, zz, xy, yz, xz, as our Voigt vector.
+    Frame {
+        points: mesh.nodes.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        hexes: mesh.hexes.clone(),
+        point_data: vec![
+            Field::new("displacement", 3, u.to_vec()),
+            Field::scalar("contact_status", status),
+            Field::scalar("gap", gap),
+            Field::scalar("lambda_n", lambda_n),
+            Field::scalar("lambda_t_norm", lambda_t),
+            Field::scalar("contact_pressure", pressure),
+            Field::scalar("frictional_work", work),
+            Field::scalar("accumulated_slip", slip),
+            Field::scalar("mu", mu),
+        ],
+        cell_data: vec![Field::new("stress", 6, stress), Field::scalar("von_mises", von_mises)],
+    }
+}

@@ -1,0 +1,183 @@
+//! Scene objects for scripts: meshes, materials, tool surfaces, schedules, friction laws and
+//! tools. Registered in one place; scripts see only these functions.
+
+use super::convert::*;
+use crate::contact::FrictionLaw;
+use crate::geometry::{Cylinder, Plane, RigidSurface, Sphere};
+use crate::material::{LinearElastic, Material};
+use crate::mesh::{End, Grading, Mesh};
+use crate::tool::schedule::{ScalarSchedule, Schedule};
+use crate::tool::Tool;
+use rhai::{Array, Dynamic, Engine, FnPtr, Map, NativeCallContext};
+use std::sync::Arc;
+
+/// A material as scripts hold it.
+#[derive(Clone, Debug)]
+pub struct ScriptMaterial(pub Arc<dyn Material>);
+
+/// A tool surface as scripts hold it.
+#[derive(Clone, Debug)]
+pub struct ScriptSurface(pub Arc<dyn RigidSurface>);
+
+pub fn register(engine: &mut Engine) {
+    register_mesh(engine);
+    register_material(engine);
+    register_tools(engine);
+}
+
+fn parse_grading(spec: &Map) -> ScriptResult<[Grading; 3]> {
+    let mut g = [Grading::Uniform, Grading::Uniform, Grading::Uniform];
+    for (key, value) in spec {
+        let axis = match key.as_str() {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            other => return runtime_error(format!("grading axis '{other}' must be x, y or z")),
+        };
+        let pair = value
+            .clone()
+            .try_cast::<Array>()
+            .filter(|a| a.len() == 2)
+            .ok_or_else(|| format!("grading.{key} must be [\"min\" or \"max\", ratio]"))
+            .or_else(runtime_error)?;
+        let end = match pair[0].clone().into_string().unwrap_or_default().as_str() {
+            "min" => End::Min,
+            "max" => End::Max,
+            other => return runtime_error(format!("grading.{key}[0] = '{other}' must be \"min\" or \"max\"")),
+        };
+        let ratio = number(&pair[1], &format!("grading.{key}[1]"))?;
+        g[axis] = Grading::Toward { end, ratio };
+    }
+    Ok(g)
+}
+
+fn register_mesh(engine: &mut Engine) {
+    engine.register_type_with_name::<Mesh>("Mesh");
+    engine.register_fn("block", |origin: Array, size: Array, cells: Array| -> ScriptResult<Mesh> {
+        lift(Mesh::block(vec3(&origin, "block origin")?, vec3(&size, "block size")?, counts3(&cells, "block cells")?))
+    });
+    engine.register_fn(
+        "block",
+        |origin: Array, size: Array, cells: Array, grading: Map| -> ScriptResult<Mesh> {
+            lift(Mesh::block_graded(
+                vec3(&origin, "block origin")?,
+                vec3(&size, "block size")?,
+                counts3(&cells, "block cells")?,
+                parse_grading(&grading)?,
+            ))
+        },
+    );
+    engine.register_get("n_nodes", |m: &mut Mesh| m.nodes.len() as i64);
+    engine.register_get("n_elements", |m: &mut Mesh| m.hexes.len() as i64);
+    engine.register_fn("node_set", |m: &mut Mesh, name: &str| -> ScriptResult<Array> {
+        Ok(lift(m.node_set(name))?.iter().map(|&n| Dynamic::from(n as i64)).collect())
+    });
+    engine.register_fn("position", |m: &mut Mesh, node: i64| -> ScriptResult<Array> {
+        match m.nodes.get(node as usize) {
+            Some(p) if node >= 0 => Ok(array3(p)),
+            _ => runtime_error(format!("node {node} is out of range (mesh has {} nodes)", m.nodes.len())),
+        }
+    });
+    // Named node set from a predicate |x, y, z| -> bool over reference coordinates.
+    engine.register_fn(
+        "select",
+        |ctx: NativeCallContext, m: &mut Mesh, name: &str, pred: FnPtr| -> ScriptResult<i64> {
+            let mut chosen = Vec::new();
+            for (i, p) in m.nodes.iter().enumerate() {
+                if pred.call_within_context::<bool>(&ctx, (p.x, p.y, p.z))? {
+                    chosen.push(i);
+                }
+            }
+            let count = chosen.len() as i64;
+            lift(m.add_node_set(name, chosen))?;
+            Ok(count)
+        },
+    );
+    engine.register_fn("nearest_node", |m: &mut Mesh, p: Array| -> ScriptResult<i64> {
+        let q = vec3(&p, "point")?;
+        m.nodes
+            .iter()
+            .enumerate()
+            .min_by(|a, b| (a.1 - q).norm().total_cmp(&(b.1 - q).norm()))
+            .map(|(i, _)| i as i64)
+            .ok_or_else(|| "the mesh has no nodes".to_string())
+            .or_else(runtime_error)
+    });
+}
+
+fn register_material(engine: &mut Engine) {
+    engine.register_type_with_name::<ScriptMaterial>("Material");
+    engine.register_fn("linear_elastic", |e: Dynamic, nu: Dynamic| -> ScriptResult<ScriptMaterial> {
+        let m = lift(LinearElastic::new(number(&e, "Young's modulus")?, number(&nu, "Poisson's ratio")?))?;
+        Ok(ScriptMaterial(Arc::new(m)))
+    });
+    engine.register_fn("to_string", |m: &mut ScriptMaterial| format!("{:?}", m.0));
+}
+
+fn schedule_points(table: &Array, columns: usize) -> ScriptResult<Vec<Vec<f64>>> {
+    let mut rows = Vec::new();
+    for (i, row) in table.iter().enumerate() {
+        let row = row
+            .clone()
+            .try_cast::<Array>()
+            .filter(|r| r.len() == columns)
+            .ok_or_else(|| format!("schedule row {i} must be an array of {columns} numbers"))
+            .or_else(runtime_error)?;
+        rows.push(row.iter().map(|v| number(v, &format!("schedule row {i}"))).collect::<ScriptResult<Vec<f64>>>()?);
+    }
+    Ok(rows)
+}
+
+/// `[[t, dx, dy, dz], ...]` -> translation schedule.
+pub fn translation_schedule(table: &Array) -> ScriptResult<Schedule> {
+    let rows = schedule_points(table, 4)?;
+    lift(Schedule::new(rows.iter().map(|r| (r[0], crate::geometry::Vec3::new(r[1], r[2], r[3]))).collect()))
+}
+
+/// A number (constant) or `[[t, v], ...]` -> scalar schedule.
+pub fn scalar_schedule(value: &Dynamic) -> ScriptResult<ScalarSchedule> {
+    if let Some(table) = value.clone().try_cast::<Array>() {
+        let rows = schedule_points(&table, 2)?;
+        lift(ScalarSchedule::new(rows.iter().map(|r| (r[0], r[1])).collect()))
+    } else {
+        Ok(ScalarSchedule::constant(number(value, "value")?))
+    }
+}
+
+fn register_tools(engine: &mut Engine) {
+    engine.register_type_with_name::<ScriptSurface>("Surface");
+    engine.register_fn("plane", |p: Array, n: Array| -> ScriptResult<ScriptSurface> {
+        Ok(ScriptSurface(Arc::new(lift(Plane::new(vec3(&p, "plane point")?, vec3(&n, "plane normal")?))?)))
+    });
+    engine.register_fn("cylinder", |p: Array, axis: Array, r: Dynamic| -> ScriptResult<ScriptSurface> {
+        let c = Cylinder::new(vec3(&p, "cylinder axis point")?, vec3(&axis, "cylinder axis")?, number(&r, "cylinder radius")?);
+        Ok(ScriptSurface(Arc::new(lift(c)?)))
+    });
+    engine.register_fn("sphere", |c: Array, r: Dynamic| -> ScriptResult<ScriptSurface> {
+        Ok(ScriptSurface(Arc::new(lift(Sphere::new(vec3(&c, "sphere centre")?, number(&r, "sphere radius")?))?)))
+    });
+    engine.register_fn("to_string", |s: &mut ScriptSurface| s.0.describe());
+
+    engine.register_type_with_name::<FrictionLaw>("FrictionLaw");
+    engine.register_fn("coulomb", |mu: Dynamic| -> ScriptResult<FrictionLaw> {
+        lift(FrictionLaw::coulomb(number(&mu, "friction coefficient mu")?))
+    });
+    engine.register_fn("frictionless", FrictionLaw::frictionless);
+    engine.register_fn("to_string", |f: &mut FrictionLaw| f.describe());
+
+    engine.register_type_with_name::<Tool>("Tool");
+    engine.register_fn("tool", |name: &str, s: ScriptSurface| Tool::new(name, s.0));
+    // tool.path([[t, dx, dy, dz], ...]): piecewise-linear translation against time.
+    engine.register_fn("path", |t: &mut Tool, table: Array| -> ScriptResult<Tool> {
+        t.schedule = translation_schedule(&table)?;
+        Ok(t.clone())
+    });
+    engine.register_fn("friction", |t: &mut Tool, law: FrictionLaw| -> Tool {
+        t.friction = law;
+        t.clone()
+    });
+    engine.register_get("name", |t: &mut Tool| t.name.clone());
+    engine.register_fn("to_string", |t: &mut Tool| {
+        format!("tool '{}': {}, {}", t.name, t.surface.describe(), t.friction.describe())
+    });
+}

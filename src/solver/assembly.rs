@@ -1,0 +1,325 @@
+//! Residual and Jacobian of the mixed (u, lambda) system for one trial state.
+//!
+//! Unknowns: 3 displacements per node, then 3 multipliers per (tool, candidate node) pair
+//! when the augmented Lagrangian is used. Equations:
+//!
+//! ```text
+//! R_u      = f_int(u) - f_ext(t) + sum_pairs F_equi     (per node)
+//! R_lambda = F_suppl                                     (per pair)
+//! ```
+//!
+//! Dirichlet rows are replaced by unit rows (the prescribed values are set before Newton
+//! starts, so their update is zero). Cost per iteration: O(elements * 24^2 + pairs * 9)
+//! for the values, plus one projection per pair.
+
+use super::model::Model;
+use super::sparse::{SparseMatrix, SparsePattern};
+use crate::contact::{alart_curnier, ContactNodeState, Enforcement, NodalContact, OperatorParams};
+use crate::element::{in_element, Element, ElementResponse, Hex8};
+use crate::geometry::{Mat3, Projection, Vec3};
+use crate::material::PointState;
+use crate::tool::pose::Pose;
+use crate::{Error, Result};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Where each unknown lives.
+#[derive(Clone, Debug)]
+pub struct DofMap {
+    pub n_nodes: usize,
+    /// First multiplier dof of each contact (tool) block, or None under penalty.
+    pub lambda_offset: Vec<Option<usize>>,
+    pub n_dofs: usize,
+}
+
+impl DofMap {
+    pub fn new(model: &Model) -> Self {
+        let n_nodes = model.mesh.nodes.len();
+        let mut next = 3 * n_nodes;
+        let lambda_offset = model
+            .contacts
+            .iter()
+            .map(|c| match model.settings.contact.enforcement {
+                Enforcement::AugmentedLagrangian => {
+                    let off = next;
+                    next += 3 * c.candidates.len();
+                    Some(off)
+                }
+                Enforcement::Penalty => None,
+            })
+            .collect();
+        DofMap {
+            n_nodes,
+            lambda_offset,
+            n_dofs: next,
+        }
+    }
+
+    pub fn pattern(&self, model: &Model) -> SparsePattern {
+        let mut entries = Vec::new();
+        for hex in &model.mesh.hexes {
+            for &a in hex {
+                for &b in hex {
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            entries.push((3 * a + i, 3 * b + j));
+                        }
+                    }
+                }
+            }
+        }
+        for (c, contact) in model.contacts.iter().enumerate() {
+            let Some(off) = self.lambda_offset[c] else { continue };
+            for (k, &node) in contact.candidates.iter().enumerate() {
+                let l = off + 3 * k;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        entries.push((3 * node + i, l + j));
+                        entries.push((l + i, 3 * node + j));
+                        entries.push((l + i, l + j));
+                    }
+                }
+            }
+        }
+        for d in 0..self.n_dofs {
+            entries.push((d, d));
+        }
+        SparsePattern::from_entries(self.n_dofs, entries)
+    }
+}
+
+/// Wall time spent in each phase of assembly (seconds), accumulated.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PhaseTimes {
+    pub elements: f64,
+    pub contact: f64,
+    pub factorization_and_solve: f64,
+}
+
+/// Frozen contact frame of a pair (foot point and normal in the tool's frame at the start of
+/// the increment), used with [`FrameUpdate::Frozen`].
+#[derive(Clone, Copy, Debug)]
+pub struct FrozenFrame {
+    pub foot_local: Vec3,
+    pub normal_local: Vec3,
+}
+
+/// Everything Newton needs from one evaluation.
+pub struct Evaluation {
+    pub residual: Vec<f64>,
+    pub jacobian: SparseMatrix,
+    pub trial_points: Vec<PointState>,
+    /// Per contact, per candidate: operator output and projection (None: no projection).
+    pub nodal: Vec<Vec<(NodalContact, Option<Projection>)>>,
+    /// Internal forces (all dofs), for reactions and residual scaling.
+    pub f_int: Vec<f64>,
+    pub f_ext: Vec<f64>,
+}
+
+/// Inputs that stay fixed during the Newton iterations of one increment.
+pub struct IncrementContext<'a> {
+    pub model: &'a Model,
+    pub dofs: &'a DofMap,
+    pub pattern: Arc<SparsePattern>,
+    pub time: f64,
+    pub poses: Vec<Pose>,
+    pub committed_points: &'a [PointState],
+    pub committed_contact: &'a [Vec<ContactNodeState>],
+    pub frozen: Option<Vec<Vec<Option<FrozenFrame>>>>,
+    pub is_fixed: &'a [bool],
+}
+
+impl IncrementContext<'_> {
+    /// Evaluates residual and Jacobian at displacements `u` and multipliers `lambda`
+    /// (the multiplier part of the unknown vector `x = [u, lambda]`).
+    pub fn evaluate(&self, x: &[f64], times: &mut PhaseTimes) -> Result<Evaluation> {
+        let model = self.model;
+        let n = self.dofs.n_dofs;
+        let mut residual = vec![0.0; n];
+        let mut f_int = vec![0.0; 3 * self.dofs.n_nodes];
+        let mut jac = SparseMatrix::zeros(self.pattern.clone());
+        let mut trial_points = self.committed_points.to_vec();
+
+        let t0 = Instant::now();
+        let element = Hex8;
+        let per_elem = element.point_count();
+        let mut xs = [Vec3::zeros(); 8];
+        let mut us = [Vec3::zeros(); 8];
+        for (e, hex) in model.mesh.hexes.iter().enumerate() {
+            for (a, &node) in hex.iter().enumerate() {
+                xs[a] = model.mesh.nodes[node];
+                us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+            }
+            let range = e * per_elem..(e + 1) * per_elem;
+            let ElementResponse { force, stiffness } = element
+                .evaluate(
+                    &xs,
+                    &us,
+                    &self.committed_points[range.clone()],
+                    &mut trial_points[range],
+                    model.material.as_ref(),
+                )
+                .map_err(|err| Error::NoConvergence(in_element(err, e).to_string()))?;
+            for (a, &na) in hex.iter().enumerate() {
+                for i in 0..3 {
+                    f_int[3 * na + i] += force[3 * a + i];
+                    for (b, &nb) in hex.iter().enumerate() {
+                        for j in 0..3 {
+                            jac.add(3 * na + i, 3 * nb + j, stiffness[(3 * a + i, 3 * b + j)]);
+                        }
+                    }
+                }
+            }
+        }
+        times.elements += t0.elapsed().as_secs_f64();
+
+        let f_ext = self.external_forces();
+        for d in 0..3 * self.dofs.n_nodes {
+            residual[d] = f_int[d] - f_ext[d];
+        }
+
+        let t1 = Instant::now();
+        // Multiplier components whose equation is replaced by lambda_k = 0 (see below).
+        let mut unit_rows: Vec<(usize, f64)> = Vec::new();
+        let mut nodal = Vec::with_capacity(model.contacts.len());
+        for (c, contact) in model.contacts.iter().enumerate() {
+            let pose = &self.poses[c];
+            let mut list = Vec::with_capacity(contact.candidates.len());
+            for (k, &node) in contact.candidates.iter().enumerate() {
+                let committed = &self.committed_contact[c][k];
+                let xn = model.mesh.nodes[node] + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+                let x_ref = pose.to_global_point(&committed.x_ref_local);
+                let proj = match &self.frozen {
+                    Some(frames) => frames[c][k].map(|f| {
+                        let foot = pose.to_global_point(&f.foot_local);
+                        let normal = pose.to_global_vector(&f.normal_local);
+                        Projection {
+                            foot,
+                            normal,
+                            gap: normal.dot(&(xn - foot)),
+                            normal_gradient: Mat3::zeros(),
+                            hint: committed.hint.unwrap_or_default(),
+                        }
+                    }),
+                    None => contact.tool.project(pose, &xn, committed.hint.as_ref()),
+                };
+                let params = OperatorParams {
+                    r: contact.r[k],
+                    mu: committed.mu,
+                    curvature: model.settings.contact.curvature,
+                };
+                let lam_dof = self.dofs.lambda_offset[c].map(|off| off + 3 * k);
+                let lambda = match lam_dof {
+                    Some(l) => Vec3::new(x[l], x[l + 1], x[l + 2]),
+                    None => Vec3::zeros(),
+                };
+                let result = match (proj.as_ref(), lam_dof) {
+                    (Some(p), Some(_)) => alart_curnier(&xn, &x_ref, &lambda, p, &params),
+                    (Some(p), None) => penalty(&xn, &x_ref, committed, p, &params),
+                    (None, _) => far_from_tool(&lambda, params.r),
+                };
+                for i in 0..3 {
+                    residual[3 * node + i] += result.f_equi[i];
+                    for j in 0..3 {
+                        jac.add(3 * node + i, 3 * node + j, result.equi_x[(i, j)]);
+                    }
+                }
+                if let Some(l) = lam_dof {
+                    // A sticking node with a prescribed displacement component k: its
+                    // tangential force along k and the support reaction are one and the same
+                    // unknown (the Jacobian is singular), so the support carries it:
+                    // lambda_k = 0. This is exact on symmetry planes and in plane strain,
+                    // where the tool normal lies in the constrained plane.
+                    if result.status == crate::contact::ContactStatus::Stick {
+                        for k in 0..3 {
+                            if self.is_fixed[3 * node + k] {
+                                unit_rows.push((l + k, lambda[k]));
+                            }
+                        }
+                    }
+                    for i in 0..3 {
+                        residual[l + i] = result.f_suppl[i];
+                        for j in 0..3 {
+                            jac.add(3 * node + i, l + j, result.equi_lambda[(i, j)]);
+                            jac.add(l + i, 3 * node + j, result.suppl_x[(i, j)]);
+                            jac.add(l + i, l + j, result.suppl_lambda[(i, j)]);
+                        }
+                    }
+                }
+                list.push((result, proj));
+            }
+            nodal.push(list);
+        }
+        times.contact += t1.elapsed().as_secs_f64();
+
+        let mut unit = self.is_fixed.to_vec();
+        for (d, fixed) in self.is_fixed.iter().enumerate() {
+            if *fixed {
+                residual[d] = 0.0;
+            }
+        }
+        for &(d, value) in &unit_rows {
+            unit[d] = true;
+            residual[d] = value;
+        }
+        jac.set_unit_rows(&unit);
+        Ok(Evaluation {
+            residual,
+            jacobian: jac,
+            trial_points,
+            nodal,
+            f_int,
+            f_ext,
+        })
+    }
+
+    pub fn external_forces(&self) -> Vec<f64> {
+        let mut f = vec![0.0; 3 * self.dofs.n_nodes];
+        for load in &self.model.loads {
+            let total = load.total * load.scale.value(self.time);
+            for (&node, &w) in load.nodes.iter().zip(&load.weights) {
+                for i in 0..3 {
+                    f[3 * node + i] += w * total[i];
+                }
+            }
+        }
+        f
+    }
+}
+
+/// A node whose projection is undefined: no contact force, the multiplier equation drives
+/// lambda to zero.
+fn far_from_tool(lambda: &Vec3, r: f64) -> NodalContact {
+    NodalContact {
+        status: crate::contact::ContactStatus::Gap,
+        f_equi: Vec3::zeros(),
+        f_suppl: -lambda / r,
+        equi_x: Mat3::zeros(),
+        equi_lambda: Mat3::zeros(),
+        suppl_x: Mat3::zeros(),
+        suppl_lambda: -Mat3::identity() / r,
+        slip_increment: Vec3::zeros(),
+    }
+}
+
+/// Plain penalty: the operator evaluated with lambda = the committed tangential force
+/// (projected on the current tangent plane), which is not an unknown. The normal force is
+/// r d_n, so the constraint is violated by (normal force)/r.
+fn penalty(
+    x: &Vec3,
+    x_ref: &Vec3,
+    committed: &ContactNodeState,
+    proj: &Projection,
+    params: &OperatorParams,
+) -> NodalContact {
+    let n = proj.normal;
+    let lc = committed.lambda - committed.normal * committed.lambda.dot(&committed.normal);
+    let lambda = lc - n * n.dot(&lc);
+    let mut res = alart_curnier(x, x_ref, &lambda, proj, params);
+    if params.curvature {
+        let g = proj.normal_gradient;
+        let dlambda_dx = -(g * n.dot(&lc)) - n * (lc.transpose() * g);
+        res.equi_x += res.equi_lambda * dlambda_dx;
+    }
+    res
+}

@@ -1,0 +1,217 @@
+//! The scene to simulate: body, boundary conditions, loads, tools and solver settings.
+//! A `Model` holds no solution; see [`super::Simulation`] for the evolving state.
+
+use crate::contact::ContactSettings;
+use crate::geometry::Vec3;
+use crate::material::Material;
+use crate::mesh::Mesh;
+use crate::tool::schedule::ScalarSchedule;
+use crate::tool::Tool;
+use crate::{Error, Result};
+use std::sync::Arc;
+
+/// Prescribed value of one displacement component on a set of nodes.
+#[derive(Clone, Debug)]
+pub struct Dirichlet {
+    pub label: String,
+    pub nodes: Vec<usize>,
+    /// 0, 1, 2 for x, y, z.
+    pub component: usize,
+    pub value: ScalarSchedule,
+}
+
+/// A total force distributed over a node set in proportion to the nodes' tributary areas.
+#[derive(Clone, Debug)]
+pub struct NodalLoad {
+    pub label: String,
+    pub nodes: Vec<usize>,
+    /// Each node's share of the total (sums to 1).
+    pub weights: Vec<f64>,
+    /// Direction and magnitude at scale 1.
+    pub total: Vec3,
+    pub scale: ScalarSchedule,
+}
+
+/// Contact between a tool and the candidate nodes of the body.
+#[derive(Clone, Debug)]
+pub struct ToolContact {
+    pub tool: Tool,
+    /// Body nodes that may touch this tool.
+    pub candidates: Vec<usize>,
+    /// Tributary area of each candidate (for pressures and area-based measures).
+    pub areas: Vec<f64>,
+    /// Augmentation (or penalty) parameter r per candidate node, force/length.
+    pub r: Vec<f64>,
+}
+
+/// Newton and stepping settings.
+#[derive(Clone, Debug)]
+pub struct SolverSettings {
+    pub max_iterations: usize,
+    /// Force residual tolerance relative to the norm of internal forces and reactions.
+    pub force_rel_tol: f64,
+    /// Absolute floor for the force residual (force units).
+    pub force_abs_tol: f64,
+    /// Contact residual tolerance (length units: constraint violation).
+    pub contact_tol: f64,
+    /// End of pseudo-time.
+    pub end_time: f64,
+    /// Number of equal increments to reach `end_time`.
+    pub increments: usize,
+    /// How many times an increment may be halved after a failed Newton solve.
+    pub max_cutbacks: usize,
+    pub contact: ContactSettings,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            max_iterations: 30,
+            force_rel_tol: 1e-9,
+            force_abs_tol: 1e-9,
+            contact_tol: 1e-9,
+            end_time: 1.0,
+            increments: 10,
+            max_cutbacks: 4,
+            contact: ContactSettings::default(),
+        }
+    }
+}
+
+/// The whole scene.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub mesh: Mesh,
+    pub material: Arc<dyn Material>,
+    pub dirichlet: Vec<Dirichlet>,
+    pub loads: Vec<NodalLoad>,
+    pub contacts: Vec<ToolContact>,
+    pub settings: SolverSettings,
+}
+
+impl Model {
+    pub fn new(mesh: Mesh, material: Arc<dyn Material>) -> Result<Self> {
+        mesh.validate()?;
+        Ok(Model {
+            mesh,
+            material,
+            dirichlet: Vec::new(),
+            loads: Vec::new(),
+            contacts: Vec::new(),
+            settings: SolverSettings::default(),
+        })
+    }
+
+    /// Node set by name (a face "x-", ..., or one the script defined).
+    pub fn nodes(&self, set: &str) -> Result<Vec<usize>> {
+        Ok(self.mesh.node_set(set)?.to_vec())
+    }
+
+    /// Prescribes `components` (subset of "xyz") of the nodes of `set` to follow `value`.
+    pub fn prescribe(&mut self, set: &str, components: &str, value: ScalarSchedule) -> Result<()> {
+        let nodes = self.nodes(set)?;
+        let comps = parse_components(components)?;
+        for c in comps {
+            self.dirichlet.push(Dirichlet {
+                label: format!("{set}.{}", ['x', 'y', 'z'][c]),
+                nodes: nodes.clone(),
+                component: c,
+                value: value.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Distributes the total force `total` (scaled by `scale(t)`) over the face set `set`.
+    pub fn add_load(&mut self, set: &str, total: Vec3, scale: ScalarSchedule) -> Result<()> {
+        let nodes = self.nodes(set)?;
+        let areas = self.mesh.tributary_areas(&nodes)?;
+        let sum: f64 = areas.iter().sum();
+        if !(sum > 0.0) {
+            return Err(Error::input(
+                &format!("load on node set '{set}': tributary area"),
+                sum,
+                "must be > 0 (is the set a boundary face?)",
+            ));
+        }
+        if !total.iter().all(|v| v.is_finite()) {
+            return Err(Error::input("load total force", format!("{total:?}"), "must be finite"));
+        }
+        self.loads.push(NodalLoad {
+            label: set.to_string(),
+            nodes,
+            weights: areas.iter().map(|a| a / sum).collect(),
+            total,
+            scale,
+        });
+        Ok(())
+    }
+
+    /// Adds a tool in contact with the nodes of `set`. `r = None` picks a default
+    /// augmentation parameter from the material stiffness and the local element size.
+    pub fn add_tool(&mut self, tool: Tool, set: &str, r: Option<f64>) -> Result<()> {
+        if self.contacts.iter().any(|c| c.tool.name == tool.name) {
+            return Err(Error::Input(format!("a tool named '{}' already exists", tool.name)));
+        }
+        if let Some(r) = r {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(Error::input(
+                    &format!("augmentation parameter r of tool '{}'", tool.name),
+                    r,
+                    "must be > 0",
+                ));
+            }
+        }
+        let candidates = self.nodes(set)?;
+        let areas = self.mesh.tributary_areas(&candidates)?;
+        // P-wave modulus times a length: the stiffness of a column of material under the node.
+        let stiffness = self.material.elastic_tangent()[(0, 0)];
+        let r = areas
+            .iter()
+            .map(|a| r.unwrap_or_else(|| stiffness * a.max(f64::MIN_POSITIVE).sqrt()))
+            .collect();
+        self.contacts.push(ToolContact {
+            tool,
+            candidates,
+            areas,
+            r,
+        });
+        Ok(())
+    }
+
+    pub fn tool_index(&self, name: &str) -> Result<usize> {
+        self.contacts
+            .iter()
+            .position(|c| c.tool.name == name)
+            .ok_or_else(|| {
+                let known: Vec<_> = self.contacts.iter().map(|c| c.tool.name.as_str()).collect();
+                Error::Input(format!("no tool named '{name}' (tools: {known:?})"))
+            })
+    }
+}
+
+/// "xz" -> [0, 2]; anything but x, y, z is an error naming the letter.
+pub fn parse_components(s: &str) -> Result<Vec<usize>> {
+    let mut out = Vec::new();
+    for ch in s.chars() {
+        let c = match ch {
+            'x' | 'X' => 0,
+            'y' | 'Y' => 1,
+            'z' | 'Z' => 2,
+            _ => {
+                return Err(Error::input(
+                    "displacement component",
+                    format!("'{ch}' in \"{s}\""),
+                    "must be x, y or z",
+                ))
+            }
+        };
+        if !out.contains(&c) {
+            out.push(c);
+        }
+    }
+    if out.is_empty() {
+        return Err(Error::input("displacement components", "\"\"", "must name at least one of x, y, z"));
+    }
+    Ok(out)
+}

@@ -1,0 +1,419 @@
+//! The incremental stepper: pseudo-time increments, each solved by a generalised Newton
+//! method on (u, lambda), with commit of history variables on convergence and rollback
+//! (halving the increment) on failure. Nothing committed is ever lost: a failed increment
+//! leaves the last converged state untouched.
+
+use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use super::linear::{FaerLu, LinearSolver};
+use super::model::Model;
+use super::sparse::SparsePattern;
+use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate};
+use crate::element::{Element, Hex8};
+use crate::geometry::Vec3;
+use crate::material::PointState;
+use crate::{Error, Result};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// One Newton iteration's residual norms.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct IterationRecord {
+    /// Force residual (2-norm over free displacement dofs) divided by the reference force.
+    pub force_rel: f64,
+    /// Force residual 2-norm (force units).
+    pub force: f64,
+    /// Contact residual (max |F_suppl|, length units).
+    pub contact: f64,
+}
+
+/// What one converged increment did.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct IncrementReport {
+    pub index: usize,
+    pub time: f64,
+    pub dt: f64,
+    /// Number of linear solves.
+    pub iterations: usize,
+    /// Residuals before each solve and at convergence.
+    pub residuals: Vec<IterationRecord>,
+    /// Halvings needed before this increment converged.
+    pub cutbacks: usize,
+    /// Total force on each tool (force the body exerts on the tool), in tool order.
+    pub tool_forces: Vec<[f64; 3]>,
+    pub active_nodes: usize,
+    pub slipping_nodes: usize,
+}
+
+/// Model plus its evolving, committed solution.
+pub struct Simulation {
+    pub model: Model,
+    dofs: DofMap,
+    pattern: Arc<SparsePattern>,
+    is_fixed: Vec<bool>,
+    linear: FaerLu,
+    /// Committed unknowns [u, lambda].
+    x: Vec<f64>,
+    points: Vec<PointState>,
+    contact: Vec<Vec<ContactNodeState>>,
+    time: f64,
+    increments_done: usize,
+    pub history: Vec<IncrementReport>,
+    pub phase_times: PhaseTimes,
+}
+
+impl Simulation {
+    /// Sets up unknowns and initial history. Fails on an invalid model.
+    pub fn new(model: Model) -> Result<Self> {
+        model.mesh.validate()?;
+        if model.settings.increments == 0 {
+            return Err(Error::input("number of increments", 0, "must be >= 1"));
+        }
+        if !(model.settings.end_time > 0.0 && model.settings.end_time.is_finite()) {
+            return Err(Error::input("end time", model.settings.end_time, "must be > 0"));
+        }
+        let dofs = DofMap::new(&model);
+        let pattern = Arc::new(dofs.pattern(&model));
+        let mut is_fixed = vec![false; dofs.n_dofs];
+        for bc in &model.dirichlet {
+            for &node in &bc.nodes {
+                is_fixed[3 * node + bc.component] = true;
+            }
+        }
+        let points = vec![PointState::default(); model.mesh.hexes.len() * Hex8.point_count()];
+        let contact = model
+            .contacts
+            .iter()
+            .map(|c| {
+                let pose = c.tool.pose(0.0);
+                c.candidates
+                    .iter()
+                    .map(|&node| {
+                        let x0 = model.mesh.nodes[node];
+                        let mut s = ContactNodeState {
+                            x_ref_local: pose.to_local(&x0),
+                            ..Default::default()
+                        };
+                        if let Some(p) = c.tool.project(&pose, &x0, None) {
+                            s.hint = Some(p.hint);
+                            s.gap = p.gap;
+                            s.normal = p.normal;
+                        }
+                        s.mu = c.tool.friction.mu(&s);
+                        s
+                    })
+                    .collect()
+            })
+            .collect();
+        Ok(Simulation {
+            x: vec![0.0; dofs.n_dofs],
+            dofs,
+            pattern,
+            is_fixed,
+            linear: FaerLu::default(),
+            points,
+            contact,
+            time: 0.0,
+            increments_done: 0,
+            history: Vec::new(),
+            phase_times: PhaseTimes::default(),
+            model,
+        })
+    }
+
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    pub fn is_finished(&self) -> bool {
+        self.time >= self.model.settings.end_time * (1.0 - 1e-12)
+    }
+
+    pub fn nominal_dt(&self) -> f64 {
+        self.model.settings.end_time / self.model.settings.increments as f64
+    }
+
+    /// Committed displacement of a node.
+    pub fn displacement(&self, node: usize) -> Vec3 {
+        Vec3::new(self.x[3 * node], self.x[3 * node + 1], self.x[3 * node + 2])
+    }
+
+    /// Committed displacements, 3 per node.
+    pub fn displacements(&self) -> &[f64] {
+        &self.x[..3 * self.dofs.n_nodes]
+    }
+
+    pub fn points(&self) -> &[PointState] {
+        &self.points
+    }
+
+    /// Committed contact states of tool `c`, in the order of its candidate nodes.
+    pub fn contact_states(&self, c: usize) -> &[ContactNodeState] {
+        &self.contact[c]
+    }
+
+    /// Total force on tool `c` at the committed state (sum of multipliers).
+    pub fn tool_force(&self, c: usize) -> Vec3 {
+        self.contact[c].iter().map(|s| s.lambda).sum()
+    }
+
+    /// Reaction force on the nodes of a Dirichlet node set at the committed state.
+    pub fn reaction(&mut self, nodes: &[usize]) -> Result<Vec3> {
+        let eval = self.evaluate_at(self.time, &self.x.clone())?;
+        let mut r = Vec3::zeros();
+        for &node in nodes {
+            for i in 0..3 {
+                let d = 3 * node + i;
+                let contact: f64 = 0.0;
+                r[i] += eval.f_int[d] - eval.f_ext[d] + contact;
+            }
+        }
+        // Contact forces on these nodes also load the support.
+        for (c, contact) in self.model.contacts.iter().enumerate() {
+            for (k, &node) in contact.candidates.iter().enumerate() {
+                if nodes.contains(&node) {
+                    r += eval.nodal[c][k].0.f_equi;
+                }
+            }
+        }
+        Ok(r)
+    }
+
+    fn context(&self, time: f64, frozen: Option<Vec<Vec<Option<FrozenFrame>>>>) -> IncrementContext<'_> {
+        IncrementContext {
+            model: &self.model,
+            dofs: &self.dofs,
+            pattern: self.pattern.clone(),
+            time,
+            poses: self.model.contacts.iter().map(|c| c.tool.pose(time)).collect(),
+            committed_points: &self.points,
+            committed_contact: &self.contact,
+            frozen,
+            is_fixed: &self.is_fixed,
+        }
+    }
+
+    /// Committed unknowns [u, lambda].
+    pub fn unknowns(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// Residual and Jacobian at time `time` for trial unknowns `x` against the committed
+    /// history (what Newton sees; used to check the Jacobian by finite differences).
+    pub fn evaluate_at(&self, time: f64, x: &[f64]) -> Result<Evaluation> {
+        let mut t = PhaseTimes::default();
+        self.context(time, None).evaluate(x, &mut t)
+    }
+
+    /// Advances one nominal increment (halving it on failure up to `max_cutbacks` times).
+    pub fn step(&mut self) -> Result<IncrementReport> {
+        if self.is_finished() {
+            return Err(Error::Input(format!(
+                "the simulation already reached its end time {}",
+                self.model.settings.end_time
+            )));
+        }
+        let target = (self.time + self.nominal_dt()).min(self.model.settings.end_time);
+        let mut dt = target - self.time;
+        let mut cutbacks = 0;
+        loop {
+            let t_new = if dt >= target - self.time { target } else { self.time + dt };
+            match self.solve_increment(t_new) {
+                Ok(mut report) => {
+                    report.cutbacks = cutbacks;
+                    self.history.push(report.clone());
+                    if t_new < target {
+                        // Finish the nominal increment with the reduced size.
+                        continue;
+                    }
+                    return Ok(report);
+                }
+                Err(err @ (Error::NoConvergence(_) | Error::LinearSolver(_)))
+                    if cutbacks < self.model.settings.max_cutbacks =>
+                {
+                    let _ = err;
+                    cutbacks += 1;
+                    dt *= 0.5;
+                }
+                Err(err) => {
+                    return Err(Error::NoConvergence(format!(
+                        "increment {} from t = {} with dt = {dt} after {cutbacks} cutbacks: {err}",
+                        self.increments_done + 1,
+                        self.time
+                    )))
+                }
+            }
+        }
+    }
+
+    /// Runs to the end time, calling `on_increment` after each converged increment.
+    pub fn run(&mut self, mut on_increment: impl FnMut(&Simulation, &IncrementReport) -> Result<()>) -> Result<()> {
+        while !self.is_finished() {
+            let report = self.step()?;
+            on_increment(self, &report)?;
+        }
+        Ok(())
+    }
+
+    fn solve_increment(&mut self, t_new: f64) -> Result<IncrementReport> {
+        // The factorization cache lives outside `self` while the context borrows it.
+        let mut linear = std::mem::take(&mut self.linear);
+        let outcome = self.newton(t_new, &mut linear);
+        self.linear = linear;
+        let (x, eval, iterations, residuals, times) = outcome?;
+        self.phase_times.elements += times.elements;
+        self.phase_times.contact += times.contact;
+        self.phase_times.factorization_and_solve += times.factorization_and_solve;
+        Ok(self.commit(t_new, x, eval, iterations, residuals))
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn newton(
+        &self,
+        t_new: f64,
+        linear: &mut FaerLu,
+    ) -> Result<(Vec<f64>, Evaluation, usize, Vec<IterationRecord>, PhaseTimes)> {
+        let settings = self.model.settings.clone();
+        let mut x = self.x.clone();
+        for bc in &self.model.dirichlet {
+            let v = bc.value.value(t_new);
+            for &node in &bc.nodes {
+                x[3 * node + bc.component] = v;
+            }
+        }
+        let frozen = match settings.contact.frame {
+            FrameUpdate::EveryIteration => None,
+            FrameUpdate::Frozen => Some(self.frozen_frames(t_new)),
+        };
+        let ctx = self.context(t_new, frozen);
+        let mut times = PhaseTimes::default();
+        let mut residuals = Vec::new();
+        let mut iterations = 0;
+        let n_u = 3 * self.dofs.n_nodes;
+        let eval = loop {
+            let eval = ctx.evaluate(&x, &mut times)?;
+            let force = norm(&eval.residual[..n_u]);
+            let reference = norm(&eval.f_int).max(norm(&eval.f_ext)).max(settings.force_abs_tol);
+            let contact = eval.residual[n_u..].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let rec = IterationRecord {
+                force_rel: force / reference,
+                force,
+                contact,
+            };
+            residuals.push(rec);
+            if !(force.is_finite() && contact.is_finite()) {
+                return Err(Error::NoConvergence(format!(
+                    "non-finite residual at iteration {iterations}"
+                )));
+            }
+            let force_ok = force <= settings.force_rel_tol * reference || force <= settings.force_abs_tol;
+            if force_ok && contact <= settings.contact_tol {
+                break eval;
+            }
+            if iterations >= settings.max_iterations {
+                return Err(Error::NoConvergence(format!(
+                    "{iterations} Newton iterations without convergence (force residual {:.3e} relative, contact residual {:.3e})",
+                    rec.force_rel, contact
+                )));
+            }
+            if iterations >= 4 && residuals.len() >= 2 && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30) {
+                return Err(Error::NoConvergence(format!(
+                    "Newton diverges (force residual grew to {:.3e} relative)",
+                    rec.force_rel
+                )));
+            }
+            let mut rhs: Vec<f64> = eval.residual.iter().map(|v| -v).collect();
+            let ts = Instant::now();
+            linear.solve(&eval.jacobian, &mut rhs)?;
+            times.factorization_and_solve += ts.elapsed().as_secs_f64();
+            for (xi, dx) in x.iter_mut().zip(&rhs) {
+                *xi += dx;
+            }
+            iterations += 1;
+        };
+        Ok((x, eval, iterations, residuals, times))
+    }
+
+    fn frozen_frames(&self, t_new: f64) -> Vec<Vec<Option<FrozenFrame>>> {
+        self.model
+            .contacts
+            .iter()
+            .enumerate()
+            .map(|(c, contact)| {
+                let pose = contact.tool.pose(t_new);
+                contact
+                    .candidates
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &node)| {
+                        let xn = self.model.mesh.nodes[node] + self.displacement(node);
+                        let hint = self.contact[c][k].hint;
+                        contact.tool.project(&pose, &xn, hint.as_ref()).map(|p| FrozenFrame {
+                            foot_local: pose.to_local(&p.foot),
+                            normal_local: pose.to_local_vector(&p.normal),
+                        })
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn commit(
+        &mut self,
+        t_new: f64,
+        x: Vec<f64>,
+        eval: Evaluation,
+        iterations: usize,
+        residuals: Vec<IterationRecord>,
+    ) -> IncrementReport {
+        let mut tool_forces = Vec::new();
+        let (mut active, mut slipping) = (0, 0);
+        for (c, contact) in self.model.contacts.iter().enumerate() {
+            let pose = contact.tool.pose(t_new);
+            let mut total = Vec3::zeros();
+            for (k, &node) in contact.candidates.iter().enumerate() {
+                let (res, proj) = &eval.nodal[c][k];
+                let s = &mut self.contact[c][k];
+                let xn = self.model.mesh.nodes[node] + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+                // The converged force on the tool is F_equi (= lambda for the mixed method).
+                s.lambda = res.f_equi;
+                s.status = res.status;
+                if let Some(p) = proj {
+                    s.hint = Some(p.hint);
+                    s.gap = p.gap;
+                    s.normal = p.normal;
+                }
+                if res.status.is_active() {
+                    let lambda_t = s.lambda - s.normal * s.lambda.dot(&s.normal);
+                    s.work += lambda_t.dot(&res.slip_increment).max(0.0);
+                    s.slip += res.slip_increment.norm();
+                }
+                active += usize::from(res.status.is_active());
+                slipping += usize::from(res.status == ContactStatus::Slip);
+                s.x_ref_local = pose.to_local(&xn);
+                s.mu = contact.tool.friction.mu(s);
+                total += s.lambda;
+            }
+            tool_forces.push([total.x, total.y, total.z]);
+        }
+        self.x = x;
+        self.points = eval.trial_points;
+        let dt = t_new - self.time;
+        self.time = t_new;
+        self.increments_done += 1;
+        IncrementReport {
+            index: self.increments_done,
+            time: t_new,
+            dt,
+            iterations,
+            residuals,
+            cutbacks: 0,
+            tool_forces,
+            active_nodes: active,
+            slipping_nodes: slipping,
+        }
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|a| a * a).sum::<f64>().sqrt()
+}

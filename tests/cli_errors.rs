@@ -1,0 +1,90 @@
+//! Bad input through the command line: a clear message naming the fault and where it is,
+//! a non-zero exit code, and never a panic.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn run_script(name: &str, source: &str, extra: &[&str]) -> (i32, String) {
+    let dir = std::env::temp_dir().join(format!("tribo-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{name}.rhai"));
+    std::fs::write(&path, source).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .arg("run")
+        .arg(&path)
+        .arg("--quiet")
+        .arg("--out")
+        .arg(dir.join("out"))
+        .args(extra)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!stderr.contains("panicked"), "{name}: panic: {stderr}");
+    (out.status.code().unwrap_or(-1), stderr)
+}
+
+const SCENE: &str = r#"
+let cells = 2;
+let young = 1000.0;
+let radius = 1.0;
+let mesh = block([0, 0, 0], [1, 1, 1], [cells, 2, 2]);
+let sim = simulation(mesh, linear_elastic(young, 0.3));
+let roller = tool("roller", cylinder([0, 0, 2], [0, 1, 0], radius)).path([[0, 0, 0, 0], [1, 0, 0, -1]]);
+sim.add_tool(roller, "z+");
+"#;
+
+#[test]
+fn syntax_error_reports_file_line_and_column() {
+    let (code, err) = run_script("syntax", "let a = 1;\nlet b = (a + ;\n", &[]);
+    assert_ne!(code, 0);
+    assert!(err.contains("syntax.rhai:2:"), "{err}");
+}
+
+#[test]
+fn negative_young_modulus_is_named() {
+    let (code, err) = run_script("young", SCENE, &["--set", "young=-5"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("Young's modulus") && err.contains("-5"), "{err}");
+    assert!(err.contains("young.rhai:6:"), "the script position is given: {err}");
+}
+
+#[test]
+fn zero_cell_count_is_named() {
+    let (code, err) = run_script("cells", SCENE, &["--set", "cells=0"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("cells[0] = 0"), "{err}");
+}
+
+#[test]
+fn zero_cylinder_radius_is_named() {
+    let (code, err) = run_script("radius", SCENE, &["--set", "radius=0"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("radius") && err.contains("0"), "{err}");
+}
+
+#[test]
+fn schedule_going_back_in_time_is_named() {
+    let src = SCENE.replace("[[0, 0, 0, 0], [1, 0, 0, -1]]", "[[0, 0, 0, 0], [1, 0, 0, -1], [0.5, 0, 0, -2]]");
+    let (code, err) = run_script("schedule", &src, &[]);
+    assert_ne!(code, 0);
+    assert!(err.contains("time[2]") && err.contains("0.5"), "{err}");
+}
+
+#[test]
+fn unknown_override_is_refused() {
+    let (code, err) = run_script("override", SCENE, &["--set", "celss=3"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("celss"), "{err}");
+}
+
+#[test]
+fn missing_script_is_an_error() {
+    let out = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .args(["run", "/nonexistent/none.rhai", "--quiet"])
+        .output()
+        .unwrap();
+    assert_ne!(out.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("none.rhai"), "{err}");
+    let _ = PathBuf::new();
+}

@@ -1,0 +1,110 @@
+//! Hertz line contact: a rigid cylinder pressed into an elastic block in plane strain.
+//! Closed form for a rigid cylinder of radius R on an elastic half-space loaded by P per
+//! unit length: half-width a = sqrt(4 P R / (pi E*)), peak pressure p0 = 2 P / (pi a),
+//! E* = E / (1 - nu^2). The block (half model, symmetric about x = 0) is 20 half-widths
+//! wide and deep, so that its finite size changes a by well under the 5 % asked.
+
+mod common;
+
+use tribo::geometry::{Cylinder, Vec3};
+use tribo::mesh::{End, Grading, Mesh};
+use tribo::solver::{Model, Simulation};
+use tribo::tool::schedule::ScalarSchedule;
+
+const E: f64 = 1000.0;
+const NU: f64 = 0.3;
+const R: f64 = 50.0;
+const SIZE: f64 = 20.0;
+const INDENT: f64 = 0.04;
+
+struct HertzResult {
+    cells: usize,
+    smallest_cell: f64,
+    a_fem: f64,
+    a_exact: f64,
+    p0_fem: f64,
+    p0_exact: f64,
+}
+
+fn hertz(cells: usize) -> HertzResult {
+    let ratio = 20.0;
+    let grading = [
+        Grading::Toward { end: End::Min, ratio },
+        Grading::Uniform,
+        Grading::Toward { end: End::Max, ratio },
+    ];
+    let mesh = Mesh::block_graded(Vec3::zeros(), Vec3::new(SIZE, 1.0, SIZE), [cells, 1, cells], grading).unwrap();
+    let smallest_cell = mesh.nodes[1].x - mesh.nodes[0].x;
+    let mut model = Model::new(mesh, common::elastic(E, NU)).unwrap();
+    let cyl = Cylinder::new(Vec3::new(0.0, 0.0, SIZE + R), Vec3::y(), R).unwrap();
+    let path = [(0.0, [0.0; 3]), (1.0, [0.0, 0.0, -INDENT])];
+    model.add_tool(common::tool("cylinder", cyl, &path, 0.0), "z+", None).unwrap();
+    let zero = ScalarSchedule::constant(0.0);
+    model.prescribe("z-", "xyz", zero.clone()).unwrap();
+    model.prescribe("x-", "x", zero.clone()).unwrap();
+    model.prescribe("y-", "y", zero.clone()).unwrap();
+    model.prescribe("y+", "y", zero).unwrap();
+    model.settings.increments = 4;
+    let mut sim = Simulation::new(model).unwrap();
+    sim.run(|_, _| Ok(())).unwrap();
+
+    // Load per unit length on the full cylinder: twice the half model's, over thickness 1.
+    let p = 2.0 * sim.tool_force(0).z;
+    let e_star = E / (1.0 - NU * NU);
+    let a_exact = (4.0 * p * R / (std::f64::consts::PI * e_star)).sqrt();
+    let p0_exact = 2.0 * p / (std::f64::consts::PI * a_exact);
+
+    // Nodal pressures lambda_n / tributary area along the y = 0 row of the top face.
+    let contact = &sim.model.contacts[0];
+    let mut profile: Vec<(f64, f64, bool)> = contact
+        .candidates
+        .iter()
+        .zip(sim.contact_states(0))
+        .zip(&contact.areas)
+        .filter(|((&n, _), _)| sim.model.mesh.nodes[n].y == 0.0)
+        .map(|((&n, s), &area)| (sim.model.mesh.nodes[n].x, -s.lambda_n() / area, s.status.is_active()))
+        .collect();
+    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let p0_fem = profile[0].1;
+    // Half-width: least-squares fit of the elliptic profile p^2 = p0^2 (1 - x^2/a^2) to the
+    // active nodes, leaving out the outermost one whose tributary strip straddles the edge.
+    let active: Vec<(f64, f64)> = profile.iter().filter(|q| q.2 && q.1 > 0.0).map(|q| (q.0, q.1)).collect();
+    assert!(active.len() >= 4, "at least 4 nodes in contact on {cells} cells");
+    let fit = &active[..active.len() - 1];
+    let (sx, sy, sxx, sxy, m) = fit.iter().fold((0.0, 0.0, 0.0, 0.0, 0.0), |acc, &(x, pr)| {
+        let (u, v) = (x * x, pr * pr);
+        (acc.0 + u, acc.1 + v, acc.2 + u * u, acc.3 + u * v, acc.4 + 1.0)
+    });
+    let slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
+    let intercept = (sy - slope * sx) / m;
+    let a_fem = (-intercept / slope).sqrt();
+    HertzResult {
+        cells,
+        smallest_cell,
+        a_fem,
+        a_exact,
+        p0_fem,
+        p0_exact,
+    }
+}
+
+#[test]
+fn hertz_line_contact_converges_to_the_closed_form() {
+    let results: Vec<HertzResult> = [20, 40, 80].into_iter().map(hertz).collect();
+    println!("cells  h_min      a_fem     a_hertz   err_a     p0_fem    p0_hertz  err_p0");
+    let mut errs = Vec::new();
+    for r in &results {
+        let ea = (r.a_fem - r.a_exact).abs() / r.a_exact;
+        let ep = (r.p0_fem - r.p0_exact).abs() / r.p0_exact;
+        println!(
+            "{:5}  {:.4}  {:.5}  {:.5}  {:.4}  {:.4}  {:.4}  {:.4}",
+            r.cells, r.smallest_cell, r.a_fem, r.a_exact, ea, r.p0_fem, r.p0_exact, ep
+        );
+        errs.push((ea, ep));
+    }
+    let (ea, ep) = errs[2];
+    assert!(ea < 0.05, "half-width error {ea} on the finest mesh");
+    assert!(ep < 0.05, "peak pressure error {ep} on the finest mesh");
+    assert!(errs[1].0 < errs[0].0 && errs[2].0 < errs[1].0, "half-width error decreases: {errs:?}");
+    assert!(errs[1].1 < errs[0].1 && errs[2].1 < errs[1].1, "peak pressure error decreases: {errs:?}");
+}

@@ -1,0 +1,48 @@
+//! Runs every tests/scripts/*.rhai through the script engine; a script error or a failed
+//! script assertion fails the test and names the file, line and column.
+
+use std::path::PathBuf;
+use tribo::script::{self, HostOptions};
+
+fn out_dir(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("tribo-scripted-{}-{name}", std::process::id()))
+}
+
+#[test]
+fn every_scripted_case_passes() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scripts");
+    let mut scripts: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
+        .collect();
+    scripts.sort();
+    assert!(!scripts.is_empty(), "no scripted cases in {}", dir.display());
+    let mut failures = Vec::new();
+    for path in &scripts {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let host = HostOptions {
+            out_dir: out_dir(&name),
+            ..HostOptions::default()
+        };
+        match script::run_file(path, &[], &host) {
+            Ok(()) => println!("ok    {name}"),
+            Err(e) => {
+                println!("FAIL  {name}: {e}");
+                failures.push(format!("{name}: {e}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "failed scripted cases:\n{}", failures.join("\n"));
+}
+
+#[test]
+fn a_failed_script_assertion_is_an_error_with_its_position() {
+    let dir = out_dir("assert");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("fails.rhai");
+    std::fs::write(&path, "let x = 1;\n\nassert(x == 2, \"x is two\");\n").unwrap();
+    let err = script::run_file(&path, &[], &HostOptions::default()).unwrap_err().to_string();
+    assert!(err.contains("x is two"), "{err}");
+    assert!(err.contains("fails.rhai:3:"), "{err}");
+}
