@@ -6,7 +6,11 @@ use std::process::ExitCode;
 use tribo::script::{self, HostOptions};
 
 #[derive(Parser)]
-#[command(name = "tribo", version, about = "Implicit frictional contact of a sheet against rigid curved tools, scripted in Rhai")]
+#[command(
+    name = "tribo",
+    version,
+    about = "Implicit frictional contact of a sheet against rigid curved tools, scripted in Rhai"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -47,7 +51,12 @@ fn default_out(script: Option<&PathBuf>) -> PathBuf {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { script, out, set, quiet } => (|| {
+        Command::Run {
+            script,
+            out,
+            set,
+            quiet,
+        } => (|| {
             let overrides = set
                 .iter()
                 .map(|s| script::parse_override(s))

@@ -44,8 +44,14 @@ fn syntax_error_reports_file_line_and_column() {
 fn negative_young_modulus_is_named() {
     let (code, err) = run_script("young", SCENE, &["--set", "young=-5"]);
     assert_ne!(code, 0);
-    assert!(err.contains("Young's modulus") && err.contains("-5"), "{err}");
-    assert!(err.contains("young.rhai:6:"), "the script position is given: {err}");
+    assert!(
+        err.contains("Young's modulus") && err.contains("-5"),
+        "{err}"
+    );
+    assert!(
+        err.contains("young.rhai:6:"),
+        "the script position is given: {err}"
+    );
 }
 
 #[test]
@@ -64,7 +70,10 @@ fn zero_cylinder_radius_is_named() {
 
 #[test]
 fn schedule_going_back_in_time_is_named() {
-    let src = SCENE.replace("[[0, 0, 0, 0], [1, 0, 0, -1]]", "[[0, 0, 0, 0], [1, 0, 0, -1], [0.5, 0, 0, -2]]");
+    let src = SCENE.replace(
+        "[[0, 0, 0, 0], [1, 0, 0, -1]]",
+        "[[0, 0, 0, 0], [1, 0, 0, -1], [0.5, 0, 0, -2]]",
+    );
     let (code, err) = run_script("schedule", &src, &[]);
     assert_ne!(code, 0);
     assert!(err.contains("time[2]") && err.contains("0.5"), "{err}");

@@ -10,12 +10,19 @@ use tribo::tool::Tool;
 
 fn moved_tool(surface: Arc<dyn RigidSurface>) -> Tool {
     let mut t = Tool::new("t", surface);
-    t.schedule = Schedule::new(vec![(0.0, Vec3::zeros()), (1.0, Vec3::new(0.3, -0.2, 0.1))]).unwrap();
+    t.schedule =
+        Schedule::new(vec![(0.0, Vec3::zeros()), (1.0, Vec3::new(0.3, -0.2, 0.1))]).unwrap();
     t
 }
 
 /// Residual [F_equi, F_suppl] at (x, lambda), and the status.
-fn residual(tool: &Tool, x: &Vec3, l: &Vec3, xr: &Vec3, p: &OperatorParams) -> (ContactStatus, [f64; 6]) {
+fn residual(
+    tool: &Tool,
+    x: &Vec3,
+    l: &Vec3,
+    xr: &Vec3,
+    p: &OperatorParams,
+) -> (ContactStatus, [f64; 6]) {
     let pose = tool.pose(0.5);
     let proj = tool.project(&pose, x, None).expect("projection defined");
     let r = alart_curnier(x, xr, l, &proj, p);
@@ -29,7 +36,11 @@ fn residual(tool: &Tool, x: &Vec3, l: &Vec3, xr: &Vec3, p: &OperatorParams) -> (
 
 /// Worst relative mismatch between the analytic Jacobian and central differences.
 fn fd_mismatch(tool: &Tool, x: Vec3, l: Vec3, xr: Vec3, expect: ContactStatus) -> f64 {
-    let p = OperatorParams { r: 80.0, mu: 0.3, curvature: true };
+    let p = OperatorParams {
+        r: 80.0,
+        mu: 0.3,
+        curvature: true,
+    };
     let pose = tool.pose(0.5);
     let proj = tool.project(&pose, &x, None).unwrap();
     let res = alart_curnier(&x, &xr, &l, &proj, &p);
@@ -47,7 +58,11 @@ fn fd_mismatch(tool: &Tool, x: Vec3, l: Vec3, xr: Vec3, expect: ContactStatus) -
         }
         let (sp, rp) = residual(tool, &xp, &lp, &xr, &p);
         let (sm, rm) = residual(tool, &xm, &lm, &xr, &p);
-        assert_eq!((sp, sm), (expect, expect), "status constant over the stencil");
+        assert_eq!(
+            (sp, sm),
+            (expect, expect),
+            "status constant over the stencil"
+        );
         for i in 0..6 {
             let fd = (rp[i] - rm[i]) / (2.0 * h);
             let an = match (i < 3, j < 3) {
@@ -74,13 +89,24 @@ fn check_all_statuses(name: &str, tool: &Tool) {
     let xr = foot + t1 * 0.01;
     let cases = [
         (ContactStatus::Gap, foot + n * 0.2, Vec3::zeros()),
-        (ContactStatus::Stick, foot - n * 0.01 + t1 * 0.0105, -n * 10.0),
-        (ContactStatus::Slip, foot - n * 0.02 + t1 * 0.3, -n * 3.0 + t1 * 0.5),
+        (
+            ContactStatus::Stick,
+            foot - n * 0.01 + t1 * 0.0105,
+            -n * 10.0,
+        ),
+        (
+            ContactStatus::Slip,
+            foot - n * 0.02 + t1 * 0.3,
+            -n * 3.0 + t1 * 0.5,
+        ),
     ];
     for (status, x, l) in cases {
         let m = fd_mismatch(tool, x, l, xr, status);
         println!("{name:9} {status:?}: relative mismatch {m:.2e}");
-        assert!(m < 1e-6, "{name} {status:?}: Jacobian differs from finite differences by {m:.2e}");
+        assert!(
+            m < 1e-6,
+            "{name} {status:?}: Jacobian differs from finite differences by {m:.2e}"
+        );
     }
 }
 

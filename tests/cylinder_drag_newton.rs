@@ -29,10 +29,18 @@ fn drag_model(curvature: bool) -> Model {
         (1.0, [0.0, 0.0, -0.02 - DEPTH]),
         (3.0, [DRAG, 0.0, -0.02 - DEPTH]),
     ];
-    model.add_tool(common::tool("roller", cyl, &path, 0.2), "z+", None).unwrap();
-    model.prescribe("z-", "xyz", ScalarSchedule::constant(0.0)).unwrap();
-    model.prescribe("y-", "y", ScalarSchedule::constant(0.0)).unwrap();
-    model.prescribe("y+", "y", ScalarSchedule::constant(0.0)).unwrap();
+    model
+        .add_tool(common::tool("roller", cyl, &path, 0.2), "z+", None)
+        .unwrap();
+    model
+        .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .prescribe("y-", "y", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .prescribe("y+", "y", ScalarSchedule::constant(0.0))
+        .unwrap();
     model.settings.end_time = 3.0;
     model.settings.increments = 6;
     model.settings.max_iterations = 40;
@@ -58,20 +66,32 @@ fn newton_converges_quadratically_while_dragging() {
             .collect();
         xs.iter().cloned().fold(f64::MIN, f64::max) - xs.iter().cloned().fold(f64::MAX, f64::min)
     };
-    assert!(contact_width > 0.5, "the cylinder is in contact at the end (width {contact_width})");
-    assert!(DRAG >= 2.0 * contact_width, "slip {DRAG} is at least twice the contact width {contact_width}");
+    assert!(
+        contact_width > 0.5,
+        "the cylinder is in contact at the end (width {contact_width})"
+    );
+    assert!(
+        DRAG >= 2.0 * contact_width,
+        "slip {DRAG} is at least twice the contact width {contact_width}"
+    );
 
     let mut worst: f64 = f64::INFINITY;
     println!("increment  iterations  last orders");
     for r in sim.history.iter().filter(|r| r.time > 1.0 + 1e-9) {
         let res: Vec<f64> = r.residuals.iter().map(|x| x.force_rel).collect();
         let orders = common::convergence_orders(&res, NOISE_FLOOR);
-        println!("{:9}  {:10}  {:?}  residuals {:?}", r.index, r.iterations, orders, res);
+        println!(
+            "{:9}  {:10}  {:?}  residuals {:?}",
+            r.index, r.iterations, orders, res
+        );
         if let Some(&last) = orders.last() {
             worst = worst.min(last);
         }
     }
-    assert!(worst.is_finite(), "some increment measured a convergence order");
+    assert!(
+        worst.is_finite(),
+        "some increment measured a convergence order"
+    );
     assert!(worst >= 1.8, "observed convergence order {worst} < 1.8");
 }
 
@@ -94,5 +114,8 @@ fn dropping_the_curvature_terms_costs_iterations() {
         .iter()
         .zip(without.displacements())
         .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-    assert!(d < 1e-8, "the two runs converge to the same displacements (max difference {d})");
+    assert!(
+        d < 1e-8,
+        "the two runs converge to the same displacements (max difference {d})"
+    );
 }

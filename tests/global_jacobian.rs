@@ -15,11 +15,23 @@ fn assembled_jacobian_matches_finite_differences() {
     let mesh = Mesh::block(Vec3::zeros(), Vec3::new(8.0, 1.0, 2.0), [16, 1, 4]).unwrap();
     let mut model = Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
     let cyl = Cylinder::new(Vec3::new(2.0, 0.0, 7.02), Vec3::y(), 5.0).unwrap();
-    let path = [(0.0, [0.0; 3]), (1.0, [0.0, 0.0, -0.12]), (3.0, [4.0, 0.0, -0.12])];
-    model.add_tool(common::tool("roller", cyl, &path, 0.2), "z+", None).unwrap();
-    model.prescribe("z-", "xyz", ScalarSchedule::constant(0.0)).unwrap();
-    model.prescribe("y-", "y", ScalarSchedule::constant(0.0)).unwrap();
-    model.prescribe("y+", "y", ScalarSchedule::constant(0.0)).unwrap();
+    let path = [
+        (0.0, [0.0; 3]),
+        (1.0, [0.0, 0.0, -0.12]),
+        (3.0, [4.0, 0.0, -0.12]),
+    ];
+    model
+        .add_tool(common::tool("roller", cyl, &path, 0.2), "z+", None)
+        .unwrap();
+    model
+        .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .prescribe("y-", "y", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .prescribe("y+", "y", ScalarSchedule::constant(0.0))
+        .unwrap();
     model.settings.end_time = 3.0;
     model.settings.increments = 12;
     let mut sim = Simulation::new(model).unwrap();
@@ -37,7 +49,12 @@ fn assembled_jacobian_matches_finite_differences() {
     }
     let e = sim.evaluate_at(t_new, &x).unwrap();
     let statuses: Vec<_> = e.nodal[0].iter().map(|(r, _)| r.status).collect();
-    assert!(statuses.iter().any(|s| *s == tribo::contact::ContactStatus::Slip), "some node slips");
+    assert!(
+        statuses
+            .iter()
+            .any(|s| *s == tribo::contact::ContactStatus::Slip),
+        "some node slips"
+    );
 
     let n = x.len();
     let mut fixed = vec![false; n];
@@ -62,6 +79,11 @@ fn assembled_jacobian_matches_finite_differences() {
             worst = worst.max(((rp[i] - rm[i]) / (2.0 * h) - col[i]).abs());
         }
     }
-    println!("largest Jacobian entry {scale:.3e}, worst difference to finite differences {worst:.3e}");
-    assert!(worst < 1e-6 * scale, "assembled Jacobian differs from finite differences by {worst:e}");
+    println!(
+        "largest Jacobian entry {scale:.3e}, worst difference to finite differences {worst:.3e}"
+    );
+    assert!(
+        worst < 1e-6 * scale,
+        "assembled Jacobian differs from finite differences by {worst:e}"
+    );
 }

@@ -1,8 +1,12 @@
 //! Hertz line contact: a rigid cylinder pressed into an elastic block in plane strain.
 //! Closed form for a rigid cylinder of radius R on an elastic half-space loaded by P per
 //! unit length: half-width a = sqrt(4 P R / (pi E*)), peak pressure p0 = 2 P / (pi a),
-//! E* = E / (1 - nu^2). The block (half model, symmetric about x = 0) is 20 half-widths
-//! wide and deep, so that its finite size changes a by well under the 5 % asked.
+//! E* = E / (1 - nu^2). The block (half model, symmetric about x = 0) is 25 half-widths
+//! wide and deep, so that its finite size changes a by well under the 5 % asked, and the
+//! cylinder is large (a/R = 0.003): Hertz linearises the gap, tribo does not (it projects
+//! the displaced surface, which also moves sideways by O(a^2/R)), and at a/R = 0.03 that
+//! difference alone shifted p0 by 0.2 %, hiding the mesh convergence of the finest mesh.
+//! Meshes are graded toward the contact (smallest cell 1/40 of the largest).
 
 mod common;
 
@@ -13,9 +17,9 @@ use tribo::tool::schedule::ScalarSchedule;
 
 const E: f64 = 1000.0;
 const NU: f64 = 0.3;
-const R: f64 = 50.0;
-const SIZE: f64 = 20.0;
-const INDENT: f64 = 0.04;
+const R: f64 = 500.0;
+const SIZE: f64 = 40.0;
+const INDENT: f64 = 0.01;
 
 struct HertzResult {
     cells: usize,
@@ -27,18 +31,32 @@ struct HertzResult {
 }
 
 fn hertz(cells: usize) -> HertzResult {
-    let ratio = 20.0;
+    let ratio = 40.0;
     let grading = [
-        Grading::Toward { end: End::Min, ratio },
+        Grading::Toward {
+            end: End::Min,
+            ratio,
+        },
         Grading::Uniform,
-        Grading::Toward { end: End::Max, ratio },
+        Grading::Toward {
+            end: End::Max,
+            ratio,
+        },
     ];
-    let mesh = Mesh::block_graded(Vec3::zeros(), Vec3::new(SIZE, 1.0, SIZE), [cells, 1, cells], grading).unwrap();
+    let mesh = Mesh::block_graded(
+        Vec3::zeros(),
+        Vec3::new(SIZE, 1.0, SIZE),
+        [cells, 1, cells],
+        grading,
+    )
+    .unwrap();
     let smallest_cell = mesh.nodes[1].x - mesh.nodes[0].x;
     let mut model = Model::new(mesh, common::elastic(E, NU)).unwrap();
     let cyl = Cylinder::new(Vec3::new(0.0, 0.0, SIZE + R), Vec3::y(), R).unwrap();
     let path = [(0.0, [0.0; 3]), (1.0, [0.0, 0.0, -INDENT])];
-    model.add_tool(common::tool("cylinder", cyl, &path, 0.0), "z+", None).unwrap();
+    model
+        .add_tool(common::tool("cylinder", cyl, &path, 0.0), "z+", None)
+        .unwrap();
     let zero = ScalarSchedule::constant(0.0);
     model.prescribe("z-", "xyz", zero.clone()).unwrap();
     model.prescribe("x-", "x", zero.clone()).unwrap();
@@ -62,18 +80,37 @@ fn hertz(cells: usize) -> HertzResult {
         .zip(sim.contact_states(0))
         .zip(&contact.areas)
         .filter(|((&n, _), _)| sim.model.mesh.nodes[n].y == 0.0)
-        .map(|((&n, s), &area)| (sim.model.mesh.nodes[n].x, -s.lambda_n() / area, s.status.is_active()))
+        .map(|((&n, s), &area)| {
+            (
+                sim.model.mesh.nodes[n].x,
+                -s.lambda_n() / area,
+                s.status.is_active(),
+            )
+        })
         .collect();
     profile.sort_by(|a, b| a.0.total_cmp(&b.0));
     let p0_fem = profile[0].1;
     // Half-width: least-squares fit of the elliptic profile p^2 = p0^2 (1 - x^2/a^2) to the
     // active nodes, leaving out the outermost one whose tributary strip straddles the edge.
-    let active: Vec<(f64, f64)> = profile.iter().filter(|q| q.2 && q.1 > 0.0).map(|q| (q.0, q.1)).collect();
-    assert!(active.len() >= 4, "at least 4 nodes in contact on {cells} cells");
+    let active: Vec<(f64, f64)> = profile
+        .iter()
+        .filter(|q| q.2 && q.1 > 0.0)
+        .map(|q| (q.0, q.1))
+        .collect();
+    assert!(
+        active.len() >= 4,
+        "at least 4 nodes in contact on {cells} cells"
+    );
     let fit = &active[..active.len() - 1];
     let (sx, sy, sxx, sxy, m) = fit.iter().fold((0.0, 0.0, 0.0, 0.0, 0.0), |acc, &(x, pr)| {
         let (u, v) = (x * x, pr * pr);
-        (acc.0 + u, acc.1 + v, acc.2 + u * u, acc.3 + u * v, acc.4 + 1.0)
+        (
+            acc.0 + u,
+            acc.1 + v,
+            acc.2 + u * u,
+            acc.3 + u * v,
+            acc.4 + 1.0,
+        )
     });
     let slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
     let intercept = (sy - slope * sx) / m;
@@ -90,7 +127,7 @@ fn hertz(cells: usize) -> HertzResult {
 
 #[test]
 fn hertz_line_contact_converges_to_the_closed_form() {
-    let results: Vec<HertzResult> = [20, 40, 80].into_iter().map(hertz).collect();
+    let results: Vec<HertzResult> = [12, 24, 48].into_iter().map(hertz).collect();
     println!("cells  h_min      a_fem     a_hertz   err_a     p0_fem    p0_hertz  err_p0");
     let mut errs = Vec::new();
     for r in &results {
@@ -105,6 +142,12 @@ fn hertz_line_contact_converges_to_the_closed_form() {
     let (ea, ep) = errs[2];
     assert!(ea < 0.05, "half-width error {ea} on the finest mesh");
     assert!(ep < 0.05, "peak pressure error {ep} on the finest mesh");
-    assert!(errs[1].0 < errs[0].0 && errs[2].0 < errs[1].0, "half-width error decreases: {errs:?}");
-    assert!(errs[1].1 < errs[0].1 && errs[2].1 < errs[1].1, "peak pressure error decreases: {errs:?}");
+    assert!(
+        errs[1].0 < errs[0].0 && errs[2].0 < errs[1].0,
+        "half-width error decreases: {errs:?}"
+    );
+    assert!(
+        errs[1].1 < errs[0].1 && errs[2].1 < errs[1].1,
+        "peak pressure error decreases: {errs:?}"
+    );
 }

@@ -17,7 +17,11 @@ fn every_scripted_case_passes() {
         .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
         .collect();
     scripts.sort();
-    assert!(!scripts.is_empty(), "no scripted cases in {}", dir.display());
+    assert!(
+        !scripts.is_empty(),
+        "no scripted cases in {}",
+        dir.display()
+    );
     let mut failures = Vec::new();
     for path in &scripts {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
@@ -33,7 +37,11 @@ fn every_scripted_case_passes() {
             }
         }
     }
-    assert!(failures.is_empty(), "failed scripted cases:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "failed scripted cases:\n{}",
+        failures.join("\n")
+    );
 }
 
 #[test]
@@ -42,7 +50,9 @@ fn a_failed_script_assertion_is_an_error_with_its_position() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("fails.rhai");
     std::fs::write(&path, "let x = 1;\n\nassert(x == 2, \"x is two\");\n").unwrap();
-    let err = script::run_file(&path, &[], &HostOptions::default()).unwrap_err().to_string();
+    let err = script::run_file(&path, &[], &HostOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("x is two"), "{err}");
     assert!(err.contains("fails.rhai:3:"), "{err}");
 }

@@ -17,7 +17,11 @@ impl FrictionLaw {
     /// Constant Coulomb friction, `mu >= 0` and finite.
     pub fn coulomb(mu: f64) -> Result<Self> {
         if !(mu.is_finite() && mu >= 0.0) {
-            return Err(Error::input("friction coefficient mu", mu, "must be >= 0 and finite"));
+            return Err(Error::input(
+                "friction coefficient mu",
+                mu,
+                "must be >= 0 and finite",
+            ));
         }
         Ok(FrictionLaw::Coulomb { mu })
     }

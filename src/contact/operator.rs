@@ -122,7 +122,12 @@ pub fn alart_curnier(
     let dsigma_n_x = n.transpose() * dsigma_x + sigma.transpose() * g_mat;
 
     let (status, f_equi, equi_x, equi_lambda) = if sigma_n > 0.0 {
-        (ContactStatus::Gap, Vec3::zeros(), Mat3::zeros(), Mat3::zeros())
+        (
+            ContactStatus::Gap,
+            Vec3::zeros(),
+            Mat3::zeros(),
+            Mat3::zeros(),
+        )
     } else if sigma_t.norm() + mu * sigma_n <= 0.0 {
         (ContactStatus::Stick, sigma, dsigma_x, ident)
     } else {
@@ -205,7 +210,11 @@ mod tests {
             }
             let (sp, rp) = residual(&xp, &lp, &xr, &p);
             let (sm, rm) = residual(&xm, &lm, &xr, &p);
-            assert_eq!((sp, sm), (expect, expect), "status changed in the FD stencil");
+            assert_eq!(
+                (sp, sm),
+                (expect, expect),
+                "status changed in the FD stencil"
+            );
             for i in 0..6 {
                 let fd = (rp[i] - rm[i]) / (2.0 * h);
                 let an = match (i < 3, j < 3) {
@@ -218,13 +227,21 @@ mod tests {
                 scale = scale.max(an.abs());
             }
         }
-        assert!(worst / scale < 1e-6, "Jacobian mismatch {worst} (scale {scale})");
+        assert!(
+            worst / scale < 1e-6,
+            "Jacobian mismatch {worst} (scale {scale})"
+        );
     }
 
     #[test]
     fn jacobian_matches_finite_differences_in_each_status() {
         let xr = Vec3::new(0.05, -0.1, 0.02);
-        check_fd(Vec3::new(0.3, 0.2, 0.5), Vec3::zeros(), xr, ContactStatus::Gap);
+        check_fd(
+            Vec3::new(0.3, 0.2, 0.5),
+            Vec3::zeros(),
+            xr,
+            ContactStatus::Gap,
+        );
         check_fd(
             Vec3::new(0.1, -0.1, -0.01),
             Vec3::new(0.2, -0.1, -10.0),

@@ -18,9 +18,9 @@ mod vtk;
 pub mod run;
 
 pub use self::csv::HistoryCsv;
-pub use self::run::RunOutput;
 pub use self::folder::OutputFolder;
 pub use self::pvd::{PvdEntry, PvdSeries};
+pub use self::run::RunOutput;
 pub use self::summary::{write_summary, SUMMARY_FILE};
 pub use self::vtk::{read_vtu, read_vtu_point_field, write_vtu, Field, Frame};
 

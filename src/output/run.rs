@@ -82,7 +82,12 @@ impl RunOutput {
     }
 
     /// Writes summary.json; `error` records why a run stopped early.
-    pub fn write_summary(&self, sim: &Simulation, wall_time_s: f64, error: Option<&str>) -> Result<()> {
+    pub fn write_summary(
+        &self,
+        sim: &Simulation,
+        wall_time_s: f64,
+        error: Option<&str>,
+    ) -> Result<()> {
         let tools: serde_json::Map<String, serde_json::Value> = sim
             .model
             .contacts
@@ -156,7 +161,11 @@ pub fn frame(sim: &Simulation) -> Frame {
                 gap[node] = s.gap;
                 lambda_n[node] = ln;
                 lambda_t[node] = s.lambda_t_norm();
-                pressure[node] = if s.status == ContactStatus::Gap { 0.0 } else { -ln / contact.areas[k].max(f64::MIN_POSITIVE) };
+                pressure[node] = if s.status == ContactStatus::Gap {
+                    0.0
+                } else {
+                    -ln / contact.areas[k].max(f64::MIN_POSITIVE)
+                };
                 mu[node] = s.mu;
             }
             work[node] += s.work;
@@ -177,7 +186,8 @@ pub fn frame(sim: &Simulation) -> Frame {
             }
         }
         let s = &stress[6 * e..6 * e + 6];
-        von_mises[e] = (0.5 * ((s[0] - s[1]).powi(2) + (s[1] - s[2]).powi(2) + (s[2] - s[0]).powi(2))
+        von_mises[e] = (0.5
+            * ((s[0] - s[1]).powi(2) + (s[1] - s[2]).powi(2) + (s[2] - s[0]).powi(2))
             + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]))
             .sqrt();
     }
@@ -196,6 +206,9 @@ pub fn frame(sim: &Simulation) -> Frame {
             Field::scalar("accumulated_slip", slip),
             Field::scalar("mu", mu),
         ],
-        cell_data: vec![Field::new("stress", 6, stress), Field::scalar("von_mises", von_mises)],
+        cell_data: vec![
+            Field::new("stress", 6, stress),
+            Field::scalar("von_mises", von_mises),
+        ],
     }
 }

@@ -43,7 +43,11 @@ fn parse_grading(spec: &Map) -> ScriptResult<[Grading; 3]> {
         let end = match pair[0].clone().into_string().unwrap_or_default().as_str() {
             "min" => End::Min,
             "max" => End::Max,
-            other => return runtime_error(format!("grading.{key}[0] = '{other}' must be \"min\" or \"max\"")),
+            other => {
+                return runtime_error(format!(
+                    "grading.{key}[0] = '{other}' must be \"min\" or \"max\""
+                ))
+            }
         };
         let ratio = number(&pair[1], &format!("grading.{key}[1]"))?;
         g[axis] = Grading::Toward { end, ratio };
@@ -53,9 +57,16 @@ fn parse_grading(spec: &Map) -> ScriptResult<[Grading; 3]> {
 
 fn register_mesh(engine: &mut Engine) {
     engine.register_type_with_name::<Mesh>("Mesh");
-    engine.register_fn("block", |origin: Array, size: Array, cells: Array| -> ScriptResult<Mesh> {
-        lift(Mesh::block(vec3(&origin, "block origin")?, vec3(&size, "block size")?, counts3(&cells, "block cells")?))
-    });
+    engine.register_fn(
+        "block",
+        |origin: Array, size: Array, cells: Array| -> ScriptResult<Mesh> {
+            lift(Mesh::block(
+                vec3(&origin, "block origin")?,
+                vec3(&size, "block size")?,
+                counts3(&cells, "block cells")?,
+            ))
+        },
+    );
     engine.register_fn(
         "block",
         |origin: Array, size: Array, cells: Array, grading: Map| -> ScriptResult<Mesh> {
@@ -69,15 +80,27 @@ fn register_mesh(engine: &mut Engine) {
     );
     engine.register_get("n_nodes", |m: &mut Mesh| m.nodes.len() as i64);
     engine.register_get("n_elements", |m: &mut Mesh| m.hexes.len() as i64);
-    engine.register_fn("node_set", |m: &mut Mesh, name: &str| -> ScriptResult<Array> {
-        Ok(lift(m.node_set(name))?.iter().map(|&n| Dynamic::from(n as i64)).collect())
-    });
-    engine.register_fn("position", |m: &mut Mesh, node: i64| -> ScriptResult<Array> {
-        match m.nodes.get(node as usize) {
-            Some(p) if node >= 0 => Ok(array3(p)),
-            _ => runtime_error(format!("node {node} is out of range (mesh has {} nodes)", m.nodes.len())),
-        }
-    });
+    engine.register_fn(
+        "node_set",
+        |m: &mut Mesh, name: &str| -> ScriptResult<Array> {
+            Ok(lift(m.node_set(name))?
+                .iter()
+                .map(|&n| Dynamic::from(n as i64))
+                .collect())
+        },
+    );
+    engine.register_fn(
+        "position",
+        |m: &mut Mesh, node: i64| -> ScriptResult<Array> {
+            match m.nodes.get(node as usize) {
+                Some(p) if node >= 0 => Ok(array3(p)),
+                _ => runtime_error(format!(
+                    "node {node} is out of range (mesh has {} nodes)",
+                    m.nodes.len()
+                )),
+            }
+        },
+    );
     // Named node set from a predicate |x, y, z| -> bool over reference coordinates.
     engine.register_fn(
         "select",
@@ -93,24 +116,33 @@ fn register_mesh(engine: &mut Engine) {
             Ok(count)
         },
     );
-    engine.register_fn("nearest_node", |m: &mut Mesh, p: Array| -> ScriptResult<i64> {
-        let q = vec3(&p, "point")?;
-        m.nodes
-            .iter()
-            .enumerate()
-            .min_by(|a, b| (a.1 - q).norm().total_cmp(&(b.1 - q).norm()))
-            .map(|(i, _)| i as i64)
-            .ok_or_else(|| "the mesh has no nodes".to_string())
-            .or_else(runtime_error)
-    });
+    engine.register_fn(
+        "nearest_node",
+        |m: &mut Mesh, p: Array| -> ScriptResult<i64> {
+            let q = vec3(&p, "point")?;
+            m.nodes
+                .iter()
+                .enumerate()
+                .min_by(|a, b| (a.1 - q).norm().total_cmp(&(b.1 - q).norm()))
+                .map(|(i, _)| i as i64)
+                .ok_or_else(|| "the mesh has no nodes".to_string())
+                .or_else(runtime_error)
+        },
+    );
 }
 
 fn register_material(engine: &mut Engine) {
     engine.register_type_with_name::<ScriptMaterial>("Material");
-    engine.register_fn("linear_elastic", |e: Dynamic, nu: Dynamic| -> ScriptResult<ScriptMaterial> {
-        let m = lift(LinearElastic::new(number(&e, "Young's modulus")?, number(&nu, "Poisson's ratio")?))?;
-        Ok(ScriptMaterial(Arc::new(m)))
-    });
+    engine.register_fn(
+        "linear_elastic",
+        |e: Dynamic, nu: Dynamic| -> ScriptResult<ScriptMaterial> {
+            let m = lift(LinearElastic::new(
+                number(&e, "Young's modulus")?,
+                number(&nu, "Poisson's ratio")?,
+            ))?;
+            Ok(ScriptMaterial(Arc::new(m)))
+        },
+    );
     engine.register_fn("to_string", |m: &mut ScriptMaterial| format!("{:?}", m.0));
 }
 
@@ -123,7 +155,11 @@ fn schedule_points(table: &Array, columns: usize) -> ScriptResult<Vec<Vec<f64>>>
             .filter(|r| r.len() == columns)
             .ok_or_else(|| format!("schedule row {i} must be an array of {columns} numbers"))
             .or_else(runtime_error)?;
-        rows.push(row.iter().map(|v| number(v, &format!("schedule row {i}"))).collect::<ScriptResult<Vec<f64>>>()?);
+        rows.push(
+            row.iter()
+                .map(|v| number(v, &format!("schedule row {i}")))
+                .collect::<ScriptResult<Vec<f64>>>()?,
+        );
     }
     Ok(rows)
 }
@@ -131,14 +167,20 @@ fn schedule_points(table: &Array, columns: usize) -> ScriptResult<Vec<Vec<f64>>>
 /// `[[t, dx, dy, dz], ...]` -> translation schedule.
 pub fn translation_schedule(table: &Array) -> ScriptResult<Schedule> {
     let rows = schedule_points(table, 4)?;
-    lift(Schedule::new(rows.iter().map(|r| (r[0], crate::geometry::Vec3::new(r[1], r[2], r[3]))).collect()))
+    lift(Schedule::new(
+        rows.iter()
+            .map(|r| (r[0], crate::geometry::Vec3::new(r[1], r[2], r[3])))
+            .collect(),
+    ))
 }
 
 /// A number (constant) or `[[t, v], ...]` -> scalar schedule.
 pub fn scalar_schedule(value: &Dynamic) -> ScriptResult<ScalarSchedule> {
     if let Some(table) = value.clone().try_cast::<Array>() {
         let rows = schedule_points(&table, 2)?;
-        lift(ScalarSchedule::new(rows.iter().map(|r| (r[0], r[1])).collect()))
+        lift(ScalarSchedule::new(
+            rows.iter().map(|r| (r[0], r[1])).collect(),
+        ))
     } else {
         Ok(ScalarSchedule::constant(number(value, "value")?))
     }
@@ -146,21 +188,43 @@ pub fn scalar_schedule(value: &Dynamic) -> ScriptResult<ScalarSchedule> {
 
 fn register_tools(engine: &mut Engine) {
     engine.register_type_with_name::<ScriptSurface>("Surface");
-    engine.register_fn("plane", |p: Array, n: Array| -> ScriptResult<ScriptSurface> {
-        Ok(ScriptSurface(Arc::new(lift(Plane::new(vec3(&p, "plane point")?, vec3(&n, "plane normal")?))?)))
-    });
-    engine.register_fn("cylinder", |p: Array, axis: Array, r: Dynamic| -> ScriptResult<ScriptSurface> {
-        let c = Cylinder::new(vec3(&p, "cylinder axis point")?, vec3(&axis, "cylinder axis")?, number(&r, "cylinder radius")?);
-        Ok(ScriptSurface(Arc::new(lift(c)?)))
-    });
-    engine.register_fn("sphere", |c: Array, r: Dynamic| -> ScriptResult<ScriptSurface> {
-        Ok(ScriptSurface(Arc::new(lift(Sphere::new(vec3(&c, "sphere centre")?, number(&r, "sphere radius")?))?)))
-    });
+    engine.register_fn(
+        "plane",
+        |p: Array, n: Array| -> ScriptResult<ScriptSurface> {
+            Ok(ScriptSurface(Arc::new(lift(Plane::new(
+                vec3(&p, "plane point")?,
+                vec3(&n, "plane normal")?,
+            ))?)))
+        },
+    );
+    engine.register_fn(
+        "cylinder",
+        |p: Array, axis: Array, r: Dynamic| -> ScriptResult<ScriptSurface> {
+            let c = Cylinder::new(
+                vec3(&p, "cylinder axis point")?,
+                vec3(&axis, "cylinder axis")?,
+                number(&r, "cylinder radius")?,
+            );
+            Ok(ScriptSurface(Arc::new(lift(c)?)))
+        },
+    );
+    engine.register_fn(
+        "sphere",
+        |c: Array, r: Dynamic| -> ScriptResult<ScriptSurface> {
+            Ok(ScriptSurface(Arc::new(lift(Sphere::new(
+                vec3(&c, "sphere centre")?,
+                number(&r, "sphere radius")?,
+            ))?)))
+        },
+    );
     engine.register_fn("to_string", |s: &mut ScriptSurface| s.0.describe());
 
     engine.register_type_with_name::<FrictionLaw>("FrictionLaw");
     engine.register_fn("coulomb", |mu: Dynamic| -> ScriptResult<FrictionLaw> {
-        lift(FrictionLaw::coulomb(number(&mu, "friction coefficient mu")?))
+        lift(FrictionLaw::coulomb(number(
+            &mu,
+            "friction coefficient mu",
+        )?))
     });
     engine.register_fn("frictionless", FrictionLaw::frictionless);
     engine.register_fn("to_string", |f: &mut FrictionLaw| f.describe());
@@ -178,6 +242,11 @@ fn register_tools(engine: &mut Engine) {
     });
     engine.register_get("name", |t: &mut Tool| t.name.clone());
     engine.register_fn("to_string", |t: &mut Tool| {
-        format!("tool '{}': {}, {}", t.name, t.surface.describe(), t.friction.describe())
+        format!(
+            "tool '{}': {}, {}",
+            t.name,
+            t.surface.describe(),
+            t.friction.describe()
+        )
     });
 }

@@ -69,7 +69,10 @@ impl SimState {
             }
             Err(err) => {
                 if let Some(out) = self.output.as_mut() {
-                    let wall = self.started.map(|s| s.elapsed().as_secs_f64()).unwrap_or(0.0);
+                    let wall = self
+                        .started
+                        .map(|s| s.elapsed().as_secs_f64())
+                        .unwrap_or(0.0);
                     let _ = out.write_summary(sim, wall, Some(&err.to_string()));
                 }
                 fail(err)
@@ -78,7 +81,10 @@ impl SimState {
     }
 
     fn finish(&mut self) -> ScriptResult<()> {
-        let wall = self.started.map(|s| s.elapsed().as_secs_f64()).unwrap_or(0.0);
+        let wall = self
+            .started
+            .map(|s| s.elapsed().as_secs_f64())
+            .unwrap_or(0.0);
         if let (Some(out), Some(sim)) = (self.output.as_mut(), self.sim.as_ref()) {
             lift(out.write_summary(sim, wall, None))?;
         }
@@ -93,7 +99,10 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     m.insert("iterations".into(), Dynamic::from(r.iterations as i64));
     m.insert("cutbacks".into(), Dynamic::from(r.cutbacks as i64));
     m.insert("active_nodes".into(), Dynamic::from(r.active_nodes as i64));
-    m.insert("slipping_nodes".into(), Dynamic::from(r.slipping_nodes as i64));
+    m.insert(
+        "slipping_nodes".into(),
+        Dynamic::from(r.slipping_nodes as i64),
+    );
     let res: Array = r
         .residuals
         .iter()
@@ -102,14 +111,22 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     m.insert("residuals".into(), Dynamic::from(res));
     let mut forces = Map::new();
     for (name, f) in tools.iter().zip(&r.tool_forces) {
-        forces.insert(name.into(), Dynamic::from(f.iter().map(|v| Dynamic::from(*v)).collect::<Array>()));
+        forces.insert(
+            name.into(),
+            Dynamic::from(f.iter().map(|v| Dynamic::from(*v)).collect::<Array>()),
+        );
     }
     m.insert("tool_forces".into(), Dynamic::from(forces));
     m
 }
 
 fn tool_names(s: &SimState) -> Vec<String> {
-    let model = s.sim.as_ref().map(|x| &x.model).or(s.model.as_ref()).expect("model or simulation");
+    let model = s
+        .sim
+        .as_ref()
+        .map(|x| &x.model)
+        .or(s.model.as_ref())
+        .expect("model or simulation");
     model.contacts.iter().map(|c| c.tool.name.clone()).collect()
 }
 
@@ -163,7 +180,10 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
             return fail(Error::input(what, v, "must be > 0"));
         }
     }
-    for (what, v) in [("force_tolerance", s.force_rel_tol), ("contact_tolerance", s.contact_tol)] {
+    for (what, v) in [
+        ("force_tolerance", s.force_rel_tol),
+        ("contact_tolerance", s.contact_tol),
+    ] {
         if !(v > 0.0) {
             return fail(Error::input(what, v, "must be > 0"));
         }
@@ -174,48 +194,80 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
 pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     engine.register_type_with_name::<ScriptSim>("Simulation");
     let h = host.clone();
-    engine.register_fn("simulation", move |mesh: Mesh, mat: ScriptMaterial| -> ScriptResult<ScriptSim> {
-        let model = lift(Model::new(mesh, mat.0))?;
-        Ok(Rc::new(RefCell::new(SimState {
-            model: Some(model),
-            sim: None,
-            output: None,
-            output_every: 1,
-            host: h.clone(),
-            started: None,
-        })))
-    });
-    engine.register_fn("fix", |s: &mut ScriptSim, set: &str, comps: &str| -> ScriptResult<()> {
-        let mut st = s.borrow_mut();
-        lift(st.model_mut()?.prescribe(set, comps, crate::tool::schedule::ScalarSchedule::constant(0.0)))
-    });
-    engine.register_fn("prescribe", |s: &mut ScriptSim, set: &str, comps: &str, value: Dynamic| -> ScriptResult<()> {
-        let sched = scalar_schedule(&value)?;
-        lift(s.borrow_mut().model_mut()?.prescribe(set, comps, sched))
-    });
-    engine.register_fn("load", |s: &mut ScriptSim, set: &str, force: Array| -> ScriptResult<()> {
-        let f = vec3(&force, "load force")?;
-        lift(s.borrow_mut().model_mut()?.add_load(set, f, crate::tool::schedule::ScalarSchedule::constant(1.0)))
-    });
-    engine.register_fn("load", |s: &mut ScriptSim, set: &str, force: Array, scale: Dynamic| -> ScriptResult<()> {
-        let f = vec3(&force, "load force")?;
-        let sched = scalar_schedule(&scale)?;
-        lift(s.borrow_mut().model_mut()?.add_load(set, f, sched))
-    });
-    engine.register_fn("add_tool", |s: &mut ScriptSim, t: Tool, set: &str| -> ScriptResult<()> {
-        lift(s.borrow_mut().model_mut()?.add_tool(t, set, None))
-    });
-    engine.register_fn("add_tool", |s: &mut ScriptSim, t: Tool, set: &str, r: Dynamic| -> ScriptResult<()> {
-        let r = number(&r, "augmentation parameter r")?;
-        lift(s.borrow_mut().model_mut()?.add_tool(t, set, Some(r)))
-    });
-    engine.register_fn("settings", |s: &mut ScriptSim, spec: Map| -> ScriptResult<()> {
-        let mut st = s.borrow_mut();
-        let mut every = st.output_every;
-        apply_settings(st.model_mut()?, &mut every, &spec)?;
-        st.output_every = every;
-        Ok(())
-    });
+    engine.register_fn(
+        "simulation",
+        move |mesh: Mesh, mat: ScriptMaterial| -> ScriptResult<ScriptSim> {
+            let model = lift(Model::new(mesh, mat.0))?;
+            Ok(Rc::new(RefCell::new(SimState {
+                model: Some(model),
+                sim: None,
+                output: None,
+                output_every: 1,
+                host: h.clone(),
+                started: None,
+            })))
+        },
+    );
+    engine.register_fn(
+        "fix",
+        |s: &mut ScriptSim, set: &str, comps: &str| -> ScriptResult<()> {
+            let mut st = s.borrow_mut();
+            lift(st.model_mut()?.prescribe(
+                set,
+                comps,
+                crate::tool::schedule::ScalarSchedule::constant(0.0),
+            ))
+        },
+    );
+    engine.register_fn(
+        "prescribe",
+        |s: &mut ScriptSim, set: &str, comps: &str, value: Dynamic| -> ScriptResult<()> {
+            let sched = scalar_schedule(&value)?;
+            lift(s.borrow_mut().model_mut()?.prescribe(set, comps, sched))
+        },
+    );
+    engine.register_fn(
+        "load",
+        |s: &mut ScriptSim, set: &str, force: Array| -> ScriptResult<()> {
+            let f = vec3(&force, "load force")?;
+            lift(s.borrow_mut().model_mut()?.add_load(
+                set,
+                f,
+                crate::tool::schedule::ScalarSchedule::constant(1.0),
+            ))
+        },
+    );
+    engine.register_fn(
+        "load",
+        |s: &mut ScriptSim, set: &str, force: Array, scale: Dynamic| -> ScriptResult<()> {
+            let f = vec3(&force, "load force")?;
+            let sched = scalar_schedule(&scale)?;
+            lift(s.borrow_mut().model_mut()?.add_load(set, f, sched))
+        },
+    );
+    engine.register_fn(
+        "add_tool",
+        |s: &mut ScriptSim, t: Tool, set: &str| -> ScriptResult<()> {
+            lift(s.borrow_mut().model_mut()?.add_tool(t, set, None))
+        },
+    );
+    engine.register_fn(
+        "add_tool",
+        |s: &mut ScriptSim, t: Tool, set: &str, r: Dynamic| -> ScriptResult<()> {
+            let r = number(&r, "augmentation parameter r")?;
+            lift(s.borrow_mut().model_mut()?.add_tool(t, set, Some(r)))
+        },
+    );
+    engine.register_fn(
+        "settings",
+        |s: &mut ScriptSim, spec: Map| -> ScriptResult<()> {
+            let mut st = s.borrow_mut();
+            let mut every = st.output_every;
+            apply_settings(st.model_mut()?, &mut every, &spec)?;
+            st.output_every = every;
+            Ok(())
+        },
+    );
     engine.register_fn("step", |s: &mut ScriptSim| -> ScriptResult<Map> {
         let mut st = s.borrow_mut();
         let r = st.step_once()?;
@@ -227,7 +279,9 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     let h = host.clone();
     engine.register_fn("run", move |s: &mut ScriptSim| -> ScriptResult<Map> {
         if h.defer_run.get() {
-            println!("(repl) sim.run() deferred: step with sim.step(), or call sim.run() to finish");
+            println!(
+                "(repl) sim.run() deferred: step with sim.step(), or call sim.run() to finish"
+            );
             return Ok(Map::new());
         }
         let mut st = s.borrow_mut();
@@ -239,8 +293,10 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         let bar = h.progress.then(|| {
             let b = indicatif::ProgressBar::new(total);
             b.set_style(
-                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} increments  {msg}  [{elapsed_precise}]")
-                    .expect("valid template"),
+                indicatif::ProgressStyle::with_template(
+                    "{bar:40} {pos}/{len} increments  {msg}  [{elapsed_precise}]",
+                )
+                .expect("valid template"),
             );
             b
         });
@@ -257,7 +313,10 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             };
             if let Some(b) = &bar {
                 b.inc(1);
-                b.set_message(format!("t = {:.4}, {} Newton iterations", r.time, r.iterations));
+                b.set_message(format!(
+                    "t = {:.4}, {} Newton iterations",
+                    r.time, r.iterations
+                ));
             }
             last = Some(r);
         }
@@ -268,60 +327,87 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         let names = tool_names(&st);
         Ok(last.map(|r| report_map(&r, &names)).unwrap_or_default())
     });
-    engine.register_get("time", |s: &mut ScriptSim| s.borrow().sim.as_ref().map(|x| x.time()).unwrap_or(0.0));
-    engine.register_fn("finished", |s: &mut ScriptSim| s.borrow().sim.as_ref().is_some_and(|x| x.is_finished()));
-    engine.register_fn("tool_force", |s: &mut ScriptSim, name: &str| -> ScriptResult<Array> {
-        let mut st = s.borrow_mut();
-        let sim = st.simulation()?;
-        let c = lift(sim.model.tool_index(name))?;
-        Ok(array3(&sim.tool_force(c)))
+    engine.register_get("time", |s: &mut ScriptSim| {
+        s.borrow().sim.as_ref().map(|x| x.time()).unwrap_or(0.0)
     });
-    engine.register_fn("displacement", |s: &mut ScriptSim, node: i64| -> ScriptResult<Array> {
-        let mut st = s.borrow_mut();
-        let sim = st.simulation()?;
-        if node < 0 || node as usize >= sim.model.mesh.nodes.len() {
-            return runtime_error(format!("node {node} is out of range"));
-        }
-        Ok(array3(&sim.displacement(node as usize)))
+    engine.register_fn("finished", |s: &mut ScriptSim| {
+        s.borrow().sim.as_ref().is_some_and(|x| x.is_finished())
     });
-    engine.register_fn("reaction", |s: &mut ScriptSim, set: &str| -> ScriptResult<Array> {
-        let mut st = s.borrow_mut();
-        let sim = st.simulation()?;
-        let nodes = lift(sim.model.nodes(set))?;
-        Ok(array3(&lift(sim.reaction(&nodes))?))
-    });
+    engine.register_fn(
+        "tool_force",
+        |s: &mut ScriptSim, name: &str| -> ScriptResult<Array> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let c = lift(sim.model.tool_index(name))?;
+            Ok(array3(&sim.tool_force(c)))
+        },
+    );
+    engine.register_fn(
+        "displacement",
+        |s: &mut ScriptSim, node: i64| -> ScriptResult<Array> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            if node < 0 || node as usize >= sim.model.mesh.nodes.len() {
+                return runtime_error(format!("node {node} is out of range"));
+            }
+            Ok(array3(&sim.displacement(node as usize)))
+        },
+    );
+    engine.register_fn(
+        "reaction",
+        |s: &mut ScriptSim, set: &str| -> ScriptResult<Array> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let nodes = lift(sim.model.nodes(set))?;
+            Ok(array3(&lift(sim.reaction(&nodes))?))
+        },
+    );
     // One map per candidate node of a tool: node, position, status, gap, forces, pressure, history.
-    engine.register_fn("contact_nodes", |s: &mut ScriptSim, name: &str| -> ScriptResult<Array> {
-        let mut st = s.borrow_mut();
-        let sim = st.simulation()?;
-        let c = lift(sim.model.tool_index(name))?;
-        let contact = &sim.model.contacts[c];
-        let mut out = Array::new();
-        for (k, state) in sim.contact_states(c).iter().enumerate() {
-            let node = contact.candidates[k];
-            let x = sim.model.mesh.nodes[node] + sim.displacement(node);
-            let mut m = Map::new();
-            m.insert("node".into(), Dynamic::from(node as i64));
-            m.insert("x".into(), Dynamic::from(array3(&x)));
-            m.insert("status".into(), Dynamic::from(format!("{:?}", state.status).to_lowercase()));
-            m.insert("gap".into(), Dynamic::from(state.gap));
-            m.insert("lambda_n".into(), Dynamic::from(state.lambda_n()));
-            m.insert("lambda_t".into(), Dynamic::from(state.lambda_t_norm()));
-            m.insert("area".into(), Dynamic::from(contact.areas[k]));
-            m.insert("pressure".into(), Dynamic::from(-state.lambda_n() / contact.areas[k].max(f64::MIN_POSITIVE)));
-            m.insert("work".into(), Dynamic::from(state.work));
-            m.insert("slip".into(), Dynamic::from(state.slip));
-            m.insert("mu".into(), Dynamic::from(state.mu));
-            out.push(Dynamic::from(m));
-        }
-        Ok(out)
-    });
+    engine.register_fn(
+        "contact_nodes",
+        |s: &mut ScriptSim, name: &str| -> ScriptResult<Array> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let c = lift(sim.model.tool_index(name))?;
+            let contact = &sim.model.contacts[c];
+            let mut out = Array::new();
+            for (k, state) in sim.contact_states(c).iter().enumerate() {
+                let node = contact.candidates[k];
+                let x = sim.model.mesh.nodes[node] + sim.displacement(node);
+                let mut m = Map::new();
+                m.insert("node".into(), Dynamic::from(node as i64));
+                m.insert("x".into(), Dynamic::from(array3(&x)));
+                m.insert(
+                    "status".into(),
+                    Dynamic::from(format!("{:?}", state.status).to_lowercase()),
+                );
+                m.insert("gap".into(), Dynamic::from(state.gap));
+                m.insert("lambda_n".into(), Dynamic::from(state.lambda_n()));
+                m.insert("lambda_t".into(), Dynamic::from(state.lambda_t_norm()));
+                m.insert("area".into(), Dynamic::from(contact.areas[k]));
+                m.insert(
+                    "pressure".into(),
+                    Dynamic::from(-state.lambda_n() / contact.areas[k].max(f64::MIN_POSITIVE)),
+                );
+                m.insert("work".into(), Dynamic::from(state.work));
+                m.insert("slip".into(), Dynamic::from(state.slip));
+                m.insert("mu".into(), Dynamic::from(state.mu));
+                out.push(Dynamic::from(m));
+            }
+            Ok(out)
+        },
+    );
     engine.register_fn("history", |s: &mut ScriptSim| -> Array {
         let st = s.borrow();
         let names = tool_names(&st);
         st.sim
             .as_ref()
-            .map(|sim| sim.history.iter().map(|r| Dynamic::from(report_map(r, &names))).collect())
+            .map(|sim| {
+                sim.history
+                    .iter()
+                    .map(|r| Dynamic::from(report_map(r, &names)))
+                    .collect()
+            })
             .unwrap_or_default()
     });
     engine.register_fn("write_frame", |s: &mut ScriptSim| -> ScriptResult<()> {

@@ -7,7 +7,10 @@ pub type ScriptResult<T> = Result<T, Box<EvalAltResult>>;
 
 /// Maps a library error into a Rhai runtime error (Rhai adds the call position).
 pub fn fail<T>(err: crate::Error) -> ScriptResult<T> {
-    Err(Box::new(EvalAltResult::ErrorRuntime(err.to_string().into(), Position::NONE)))
+    Err(Box::new(EvalAltResult::ErrorRuntime(
+        err.to_string().into(),
+        Position::NONE,
+    )))
 }
 
 pub fn lift<T>(r: crate::Result<T>) -> ScriptResult<T> {
@@ -34,7 +37,11 @@ pub fn vec3(a: &Array, what: &str) -> ScriptResult<Vec3> {
     if a.len() != 3 {
         return runtime_error(format!("{what} must have 3 components, got {}", a.len()));
     }
-    Ok(Vec3::new(number(&a[0], what)?, number(&a[1], what)?, number(&a[2], what)?))
+    Ok(Vec3::new(
+        number(&a[0], what)?,
+        number(&a[1], what)?,
+        number(&a[2], what)?,
+    ))
 }
 
 pub fn array3(v: &Vec3) -> Array {

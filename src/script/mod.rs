@@ -61,13 +61,19 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
 
 /// Assertions for scripted test cases: a failed one stops the script with its message.
 fn register_checks(engine: &mut Engine) {
-    engine.register_fn("assert", |cond: bool, msg: &str| -> convert::ScriptResult<()> {
-        if cond {
-            Ok(())
-        } else {
-            Err(Box::new(EvalAltResult::ErrorRuntime(format!("assertion failed: {msg}").into(), Position::NONE)))
-        }
-    });
+    engine.register_fn(
+        "assert",
+        |cond: bool, msg: &str| -> convert::ScriptResult<()> {
+            if cond {
+                Ok(())
+            } else {
+                Err(Box::new(EvalAltResult::ErrorRuntime(
+                    format!("assertion failed: {msg}").into(),
+                    Position::NONE,
+                )))
+            }
+        },
+    );
     engine.register_fn(
         "assert_close",
         |a: f64, b: f64, rel: f64, msg: &str| -> convert::ScriptResult<()> {
@@ -76,7 +82,10 @@ fn register_checks(engine: &mut Engine) {
                 Ok(())
             } else {
                 Err(Box::new(EvalAltResult::ErrorRuntime(
-                    format!("assertion failed: {msg}: {a} and {b} differ by more than {rel} relative").into(),
+                    format!(
+                        "assertion failed: {msg}: {a} and {b} differ by more than {rel} relative"
+                    )
+                    .into(),
                     Position::NONE,
                 )))
             }
@@ -97,7 +106,8 @@ pub fn describe_error(file: &str, err: &EvalAltResult) -> String {
 
 fn innermost_position(err: &EvalAltResult) -> Position {
     match err {
-        EvalAltResult::ErrorInFunctionCall(_, _, inner, pos) | EvalAltResult::ErrorInModule(_, inner, pos) => {
+        EvalAltResult::ErrorInFunctionCall(_, _, inner, pos)
+        | EvalAltResult::ErrorInModule(_, inner, pos) => {
             let p = innermost_position(inner);
             if p.is_none() {
                 *pos
@@ -124,7 +134,9 @@ pub fn parse_override(text: &str) -> Result<(String, Dynamic)> {
         .ok_or_else(|| Error::Input(format!("--set '{text}' must have the form NAME=VALUE")))?;
     let name = name.trim();
     if name.is_empty() || !name.chars().all(|c| c.is_alphanumeric() || c == '_') {
-        return Err(Error::Input(format!("--set name '{name}' is not a valid variable name")));
+        return Err(Error::Input(format!(
+            "--set name '{name}' is not a valid variable name"
+        )));
     }
     let v = value.trim();
     let dynamic = if let Ok(i) = v.parse::<i64>() {
@@ -170,7 +182,12 @@ pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions
 /// `--set NAME=VALUE` replaces the value of the script's top-level `let NAME = ...;`
 /// (its default), so one script serves a family of runs. A name the script never declares
 /// is an error (a typo would otherwise be silently ignored).
-pub fn apply_overrides(engine: &Engine, ast: AST, overrides: &[(String, Dynamic)], path: &Path) -> Result<AST> {
+pub fn apply_overrides(
+    engine: &Engine,
+    ast: AST,
+    overrides: &[(String, Dynamic)],
+    path: &Path,
+) -> Result<AST> {
     if overrides.is_empty() {
         return Ok(ast);
     }

@@ -31,8 +31,15 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
         let loaded = engine.run_ast_with_scope(&mut scope, &ast);
         host.defer_run.set(false);
         match loaded {
-            Ok(()) => println!("loaded {} ({} variables in scope)", path.display(), scope.len()),
-            Err(e) => println!("error while loading: {}", describe_error(&path.display().to_string(), &e)),
+            Ok(()) => println!(
+                "loaded {} ({} variables in scope)",
+                path.display(),
+                scope.len()
+            ),
+            Err(e) => println!(
+                "error while loading: {}",
+                describe_error(&path.display().to_string(), &e)
+            ),
         }
     }
     println!("tribo repl: type :help for help, :quit to leave");
@@ -50,7 +57,10 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
                     ":quit" | ":q" | "exit" => break,
                     ":help" | ":h" => {
                         println!("{HELP}");
-                        println!("std-lib modules (import \"NAME\" as m;): {}", super::stdlib::module_names().join(", "));
+                        println!(
+                            "std-lib modules (import \"NAME\" as m;): {}",
+                            super::stdlib::module_names().join(", ")
+                        );
                         continue;
                     }
                     _ => {}

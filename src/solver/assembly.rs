@@ -69,7 +69,9 @@ impl DofMap {
             }
         }
         for (c, contact) in model.contacts.iter().enumerate() {
-            let Some(off) = self.lambda_offset[c] else { continue };
+            let Some(off) = self.lambda_offset[c] else {
+                continue;
+            };
             for (k, &node) in contact.candidates.iter().enumerate() {
                 let l = off + 3 * k;
                 for i in 0..3 {
@@ -187,7 +189,8 @@ impl IncrementContext<'_> {
             let mut list = Vec::with_capacity(contact.candidates.len());
             for (k, &node) in contact.candidates.iter().enumerate() {
                 let committed = &self.committed_contact[c][k];
-                let xn = model.mesh.nodes[node] + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+                let xn = model.mesh.nodes[node]
+                    + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
                 let x_ref = pose.to_global_point(&committed.x_ref_local);
                 let proj = match &self.frozen {
                     Some(frames) => frames[c][k].map(|f| {

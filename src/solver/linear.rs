@@ -77,7 +77,14 @@ mod tests {
         let entries = [(0, 0), (1, 1), (0, 2), (2, 0), (1, 2), (2, 1)];
         let p = Arc::new(SparsePattern::from_entries(3, entries));
         let mut a = SparseMatrix::zeros(p);
-        for (r, c, v) in [(0, 0, 2.0), (1, 1, 3.0), (0, 2, 1.0), (2, 0, 1.0), (1, 2, 1.0), (2, 1, 1.0)] {
+        for (r, c, v) in [
+            (0, 0, 2.0),
+            (1, 1, 3.0),
+            (0, 2, 1.0),
+            (2, 0, 1.0),
+            (1, 2, 1.0),
+            (2, 1, 1.0),
+        ] {
             a.add(r, c, v);
         }
         let x = [1.0, -2.0, 0.5];
@@ -94,7 +101,10 @@ mod tests {
 
     #[test]
     fn singular_matrix_is_an_error_not_a_panic() {
-        let p = Arc::new(SparsePattern::from_entries(2, [(0, 0), (1, 1), (0, 1), (1, 0)]));
+        let p = Arc::new(SparsePattern::from_entries(
+            2,
+            [(0, 0), (1, 1), (0, 1), (1, 0)],
+        ));
         let mut a = SparseMatrix::zeros(p);
         a.add(0, 0, 1.0);
         a.add(0, 1, 1.0);

@@ -135,7 +135,11 @@ impl Model {
             ));
         }
         if !total.iter().all(|v| v.is_finite()) {
-            return Err(Error::input("load total force", format!("{total:?}"), "must be finite"));
+            return Err(Error::input(
+                "load total force",
+                format!("{total:?}"),
+                "must be finite",
+            ));
         }
         self.loads.push(NodalLoad {
             label: set.to_string(),
@@ -151,7 +155,10 @@ impl Model {
     /// augmentation parameter from the material stiffness and the local element size.
     pub fn add_tool(&mut self, tool: Tool, set: &str, r: Option<f64>) -> Result<()> {
         if self.contacts.iter().any(|c| c.tool.name == tool.name) {
-            return Err(Error::Input(format!("a tool named '{}' already exists", tool.name)));
+            return Err(Error::Input(format!(
+                "a tool named '{}' already exists",
+                tool.name
+            )));
         }
         if let Some(r) = r {
             if !(r.is_finite() && r > 0.0) {
@@ -211,7 +218,11 @@ pub fn parse_components(s: &str) -> Result<Vec<usize>> {
         }
     }
     if out.is_empty() {
-        return Err(Error::input("displacement components", "\"\"", "must name at least one of x, y, z"));
+        return Err(Error::input(
+            "displacement components",
+            "\"\"",
+            "must name at least one of x, y, z",
+        ));
     }
     Ok(out)
 }

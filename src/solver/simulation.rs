@@ -69,7 +69,11 @@ impl Simulation {
             return Err(Error::input("number of increments", 0, "must be >= 1"));
         }
         if !(model.settings.end_time > 0.0 && model.settings.end_time.is_finite()) {
-            return Err(Error::input("end time", model.settings.end_time, "must be > 0"));
+            return Err(Error::input(
+                "end time",
+                model.settings.end_time,
+                "must be > 0",
+            ));
         }
         let dofs = DofMap::new(&model);
         let pattern = Arc::new(dofs.pattern(&model));
@@ -178,13 +182,22 @@ impl Simulation {
         Ok(r)
     }
 
-    fn context(&self, time: f64, frozen: Option<Vec<Vec<Option<FrozenFrame>>>>) -> IncrementContext<'_> {
+    fn context(
+        &self,
+        time: f64,
+        frozen: Option<Vec<Vec<Option<FrozenFrame>>>>,
+    ) -> IncrementContext<'_> {
         IncrementContext {
             model: &self.model,
             dofs: &self.dofs,
             pattern: self.pattern.clone(),
             time,
-            poses: self.model.contacts.iter().map(|c| c.tool.pose(time)).collect(),
+            poses: self
+                .model
+                .contacts
+                .iter()
+                .map(|c| c.tool.pose(time))
+                .collect(),
             committed_points: &self.points,
             committed_contact: &self.contact,
             frozen,
@@ -216,7 +229,11 @@ impl Simulation {
         let mut dt = target - self.time;
         let mut cutbacks = 0;
         loop {
-            let t_new = if dt >= target - self.time { target } else { self.time + dt };
+            let t_new = if dt >= target - self.time {
+                target
+            } else {
+                self.time + dt
+            };
             match self.solve_increment(t_new) {
                 Ok(mut report) => {
                     report.cutbacks = cutbacks;
@@ -246,7 +263,10 @@ impl Simulation {
     }
 
     /// Runs to the end time, calling `on_increment` after each converged increment.
-    pub fn run(&mut self, mut on_increment: impl FnMut(&Simulation, &IncrementReport) -> Result<()>) -> Result<()> {
+    pub fn run(
+        &mut self,
+        mut on_increment: impl FnMut(&Simulation, &IncrementReport) -> Result<()>,
+    ) -> Result<()> {
         while !self.is_finished() {
             let report = self.step()?;
             on_increment(self, &report)?;
@@ -271,7 +291,13 @@ impl Simulation {
         &self,
         t_new: f64,
         linear: &mut FaerLu,
-    ) -> Result<(Vec<f64>, Evaluation, usize, Vec<IterationRecord>, PhaseTimes)> {
+    ) -> Result<(
+        Vec<f64>,
+        Evaluation,
+        usize,
+        Vec<IterationRecord>,
+        PhaseTimes,
+    )> {
         let settings = self.model.settings.clone();
         let mut x = self.x.clone();
         for bc in &self.model.dirichlet {
@@ -292,8 +318,12 @@ impl Simulation {
         let eval = loop {
             let eval = ctx.evaluate(&x, &mut times)?;
             let force = norm(&eval.residual[..n_u]);
-            let reference = norm(&eval.f_int).max(norm(&eval.f_ext)).max(settings.force_abs_tol);
-            let contact = eval.residual[n_u..].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let reference = norm(&eval.f_int)
+                .max(norm(&eval.f_ext))
+                .max(settings.force_abs_tol);
+            let contact = eval.residual[n_u..]
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()));
             let rec = IterationRecord {
                 force_rel: force / reference,
                 force,
@@ -305,7 +335,8 @@ impl Simulation {
                     "non-finite residual at iteration {iterations}"
                 )));
             }
-            let force_ok = force <= settings.force_rel_tol * reference || force <= settings.force_abs_tol;
+            let force_ok =
+                force <= settings.force_rel_tol * reference || force <= settings.force_abs_tol;
             if force_ok && contact <= settings.contact_tol {
                 break eval;
             }
@@ -315,7 +346,10 @@ impl Simulation {
                     rec.force_rel, contact
                 )));
             }
-            if iterations >= 4 && residuals.len() >= 2 && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30) {
+            if iterations >= 4
+                && residuals.len() >= 2
+                && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30)
+            {
                 return Err(Error::NoConvergence(format!(
                     "Newton diverges (force residual grew to {:.3e} relative)",
                     rec.force_rel
@@ -347,10 +381,13 @@ impl Simulation {
                     .map(|(k, &node)| {
                         let xn = self.model.mesh.nodes[node] + self.displacement(node);
                         let hint = self.contact[c][k].hint;
-                        contact.tool.project(&pose, &xn, hint.as_ref()).map(|p| FrozenFrame {
-                            foot_local: pose.to_local(&p.foot),
-                            normal_local: pose.to_local_vector(&p.normal),
-                        })
+                        contact
+                            .tool
+                            .project(&pose, &xn, hint.as_ref())
+                            .map(|p| FrozenFrame {
+                                foot_local: pose.to_local(&p.foot),
+                                normal_local: pose.to_local_vector(&p.normal),
+                            })
                     })
                     .collect()
             })
@@ -373,7 +410,8 @@ impl Simulation {
             for (k, &node) in contact.candidates.iter().enumerate() {
                 let (res, proj) = &eval.nodal[c][k];
                 let s = &mut self.contact[c][k];
-                let xn = self.model.mesh.nodes[node] + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+                let xn = self.model.mesh.nodes[node]
+                    + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
                 // The converged force on the tool is F_equi (= lambda for the mixed method).
                 s.lambda = res.f_equi;
                 s.status = res.status;

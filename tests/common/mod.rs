@@ -12,9 +12,19 @@ pub fn elastic(young: f64, poisson: f64) -> Arc<dyn Material> {
     Arc::new(LinearElastic::new(young, poisson).unwrap())
 }
 
-pub fn tool(name: &str, surface: impl RigidSurface + 'static, path: &[(f64, [f64; 3])], mu: f64) -> Tool {
+pub fn tool(
+    name: &str,
+    surface: impl RigidSurface + 'static,
+    path: &[(f64, [f64; 3])],
+    mu: f64,
+) -> Tool {
     let mut t = Tool::new(name, Arc::new(surface));
-    t.schedule = Schedule::new(path.iter().map(|(t, d)| (*t, Vec3::new(d[0], d[1], d[2]))).collect()).unwrap();
+    t.schedule = Schedule::new(
+        path.iter()
+            .map(|(t, d)| (*t, Vec3::new(d[0], d[1], d[2])))
+            .collect(),
+    )
+    .unwrap();
     t.friction = FrictionLaw::coulomb(mu).unwrap();
     t
 }
