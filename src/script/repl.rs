@@ -16,6 +16,7 @@ Rhai lines are evaluated in a persistent scope. Useful calls on a simulation `si
   sim.time                        current pseudo-time
   sim.tool_force(\"punch\")         total force on a tool [fx, fy, fz]
   sim.contact_nodes(\"punch\")      state of every candidate node of a tool
+  sim.contact_node(\"punch\", 12)   one node's state: status, gap, lambda_n, lambda_t, work, mu
   sim.displacement(node)          a node's displacement
   sim.write_frame()               write a VTK frame now
   sim.history()                   one map per converged increment

@@ -9,9 +9,11 @@
 
 use super::sparse::{SparseMatrix, SparsePattern};
 use crate::{Error, Result};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, Par};
 use std::sync::Arc;
 
 /// Solves A x = b for a sparse square A.
@@ -20,12 +22,45 @@ pub trait LinearSolver {
     fn solve(&mut self, a: &SparseMatrix, b: &mut [f64]) -> Result<()>;
 }
 
-/// faer sparse LU with the symbolic analysis cached per pattern.
-#[derive(Default)]
+/// Which sparse LU kernel faer uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LuKernel {
+    /// faer's own choice from the estimated flop count.
+    #[default]
+    Auto,
+    Simplicial,
+    Supernodal,
+}
+
+/// faer sparse LU with partial pivoting. The symbolic analysis is cached per pattern, and
+/// the numeric factors and the workspace are kept between calls, so that a Newton
+/// iteration allocates nothing. Runs sequentially: on the small, banded systems of
+/// contact problems thread start-up costs more than it saves (measured in BENCHMARKS.md).
 pub struct FaerLu {
+    kernel: LuKernel,
     symbolic: Option<(Arc<SparsePattern>, SymbolicLu<usize>)>,
+    numeric: NumericLu<usize, f64>,
+    workspace: Option<MemBuffer>,
     /// Number of symbolic analyses done (a pattern change triggers a new one).
     pub symbolic_count: usize,
+}
+
+impl Default for FaerLu {
+    fn default() -> Self {
+        FaerLu::with_kernel(LuKernel::Auto)
+    }
+}
+
+impl FaerLu {
+    pub fn with_kernel(kernel: LuKernel) -> Self {
+        FaerLu {
+            kernel,
+            symbolic: None,
+            numeric: NumericLu::new(),
+            workspace: None,
+            symbolic_count: 0,
+        }
+    }
 }
 
 impl LinearSolver for FaerLu {
@@ -44,20 +79,40 @@ impl LinearSolver for FaerLu {
                 a.values[bad]
             )));
         }
+        let par = Par::Seq;
         let sym = SymbolicSparseColMatRef::new_checked(p.n, p.n, &p.col_ptr, None, &p.row_idx);
         let reuse = matches!(&self.symbolic, Some((q, _)) if Arc::ptr_eq(q, p) || **q == **p);
         if !reuse {
-            let s = SymbolicLu::try_new(sym)
+            let threshold = match self.kernel {
+                LuKernel::Auto => SupernodalThreshold::AUTO,
+                LuKernel::Simplicial => SupernodalThreshold::FORCE_SIMPLICIAL,
+                LuKernel::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
+            };
+            let params = LuSymbolicParams {
+                supernodal_flop_ratio_threshold: threshold,
+                ..Default::default()
+            };
+            let s = factorize_symbolic_lu(sym, params)
                 .map_err(|e| Error::LinearSolver(format!("symbolic LU failed: {e:?}")))?;
+            let req = s
+                .factorize_numeric_lu_scratch::<f64>(par, Default::default())
+                .or(s.solve_in_place_scratch::<f64>(1, par));
+            self.workspace = Some(
+                MemBuffer::try_new(req)
+                    .map_err(|e| Error::LinearSolver(format!("LU workspace: {e:?}")))?,
+            );
             self.symbolic = Some((p.clone(), s));
             self.symbolic_count += 1;
         }
-        let symbolic = self.symbolic.as_ref().expect("set above").1.clone();
+        let (_, symbolic) = self.symbolic.as_ref().expect("set above");
+        let stack = MemStack::new(self.workspace.as_mut().expect("set with the symbolic"));
         let mat = SparseColMatRef::new(sym, &a.values);
-        let lu = Lu::try_new_with_symbolic(symbolic, mat)
+        let lu = symbolic
+            .factorize_numeric_lu(&mut self.numeric, mat, par, stack, Default::default())
             .map_err(|e| Error::LinearSolver(format!("singular Jacobian ({e:?})")))?;
         let rhs = faer::MatMut::from_column_major_slice_mut(b, p.n, 1);
-        lu.solve_in_place(rhs);
+        let stack = MemStack::new(self.workspace.as_mut().expect("set with the symbolic"));
+        lu.solve_in_place_with_conj(Conj::No, rhs, par, stack);
         if let Some(bad) = b.iter().position(|v| !v.is_finite()) {
             return Err(Error::LinearSolver(format!(
                 "solution entry {bad} is not finite: the Jacobian is singular"
