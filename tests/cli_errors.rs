@@ -97,3 +97,54 @@ fn missing_script_is_an_error() {
     assert!(err.contains("none.rhai"), "{err}");
     let _ = PathBuf::new();
 }
+
+#[test]
+fn repl_loads_a_scene_and_steps_it() {
+    use std::io::Write;
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scripts/cylinder_drag.rhai");
+    let out = std::env::temp_dir().join(format!("tribo-repl-{}", std::process::id()));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .arg("repl")
+        .arg(&script)
+        .arg("--out")
+        .arg(&out)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"sim.step(); sim.step(); sim.step();\nsim.time\nsim.tool_force(\"roller\")[2] > 0.0\nsim.bogus()\n:quit\n")
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    assert!(stdout.contains("sim.run() deferred"), "{stdout}");
+    assert!(
+        stdout.contains("0.30000000000000004") || stdout.contains("0.3\n"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("true"),
+        "the roller is pushed up after 3 increments: {stdout}"
+    );
+    assert!(
+        stdout.contains("error: <repl>:1:5: Function not found: bogus"),
+        "{stdout}"
+    );
+    assert!(out.join("frames/frame_0000.vtu").exists());
+}
+
+#[test]
+fn set_accepts_strings_and_booleans() {
+    let src = "let label = \"a\";\nlet flag = false;\nassert(label == \"hello\", \"string override\");\nassert(flag, \"bool override\");\n";
+    let (code, err) = run_script(
+        "overrides",
+        src,
+        &["--set", "label=hello", "--set", "flag=true"],
+    );
+    assert_eq!(code, 0, "{err}");
+}

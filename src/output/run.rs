@@ -116,6 +116,7 @@ impl RunOutput {
             "increments": sim.history.len(),
             "newton_iterations": iterations,
             "cutbacks": sim.history.iter().map(|r| r.cutbacks).sum::<usize>(),
+            "symbolic_analyses": sim.symbolic_analyses(),
             "wall_time_s": wall_time_s,
             "phase_times_s": {
                 "elements": sim.phase_times.elements,

@@ -38,8 +38,11 @@ impl SimState {
     /// Starts the simulation on first use (the model is frozen from then on).
     pub fn simulation(&mut self) -> ScriptResult<&mut Simulation> {
         if self.sim.is_none() {
-            let model = self.model.take().expect("model present until start");
+            let Some(model) = self.model.clone() else {
+                return runtime_error("the simulation has no model");
+            };
             let sim = lift(Simulation::new(model))?;
+            self.model = None;
             if self.output_every > 0 {
                 let dir = self.host.out_dir.clone();
                 let mut out = lift(RunOutput::create(&dir, &sim))?;
@@ -398,14 +401,21 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         },
     );
     // The state of one mesh node against a tool (a map as in contact_nodes).
-    engine.register_fn("contact_node", |ctx: rhai::NativeCallContext, s: &mut ScriptSim, name: &str, node: i64| -> ScriptResult<Map> {
-        let all: Array = ctx.call_native_fn("contact_nodes", (s.clone(), name.to_string()))?;
-        all.into_iter()
-            .filter_map(|m| m.try_cast::<Map>())
-            .find(|m| m.get("node").and_then(|v| v.as_int().ok()) == Some(node))
-            .ok_or_else(|| format!("node {node} is not a contact candidate of tool '{name}'"))
-            .or_else(runtime_error)
-    });
+    engine.register_fn(
+        "contact_node",
+        |ctx: rhai::NativeCallContext,
+         s: &mut ScriptSim,
+         name: &str,
+         node: i64|
+         -> ScriptResult<Map> {
+            let all: Array = ctx.call_native_fn("contact_nodes", (s.clone(), name.to_string()))?;
+            all.into_iter()
+                .filter_map(|m| m.try_cast::<Map>())
+                .find(|m| m.get("node").and_then(|v| v.as_int().ok()) == Some(node))
+                .ok_or_else(|| format!("node {node} is not a contact candidate of tool '{name}'"))
+                .or_else(runtime_error)
+        },
+    );
     engine.register_fn("history", |s: &mut ScriptSim| -> Array {
         let st = s.borrow();
         let names = tool_names(&st);

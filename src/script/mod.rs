@@ -93,9 +93,10 @@ fn register_checks(engine: &mut Engine) {
     );
 }
 
-/// Formats a Rhai error as "file:line:column: message".
+/// Formats a Rhai error as "file:line:column: message". An error inside a function of
+/// another source (a std-lib module) is reported where this file called it.
 pub fn describe_error(file: &str, err: &EvalAltResult) -> String {
-    let pos = innermost_position(err);
+    let pos = innermost_position(file, err);
     let msg = err.to_string();
     match (pos.line(), pos.position()) {
         (Some(l), Some(c)) => format!("{file}:{l}:{c}: {msg}"),
@@ -104,27 +105,20 @@ pub fn describe_error(file: &str, err: &EvalAltResult) -> String {
     }
 }
 
-fn innermost_position(err: &EvalAltResult) -> Position {
+fn innermost_position(file: &str, err: &EvalAltResult) -> Position {
     match err {
-        EvalAltResult::ErrorInFunctionCall(_, _, inner, pos)
-        | EvalAltResult::ErrorInModule(_, inner, pos) => {
-            let p = innermost_position(inner);
-            if p.is_none() {
-                *pos
-            } else if inner_is_other_source(inner) {
+        EvalAltResult::ErrorInFunctionCall(_, source, inner, pos) => {
+            let p = innermost_position(file, inner);
+            let same_file = source.is_empty() || source.as_str() == file;
+            if p.is_none() || !same_file {
                 *pos
             } else {
                 p
             }
         }
+        EvalAltResult::ErrorInModule(_, _, pos) => *pos,
         other => other.position(),
     }
-}
-
-/// An error raised inside a function of another source (a std-lib module) keeps the caller's
-/// position in this file.
-fn inner_is_other_source(err: &EvalAltResult) -> bool {
-    matches!(err, EvalAltResult::ErrorInModule(..))
 }
 
 /// Parses a `--set NAME=VALUE` value: integer, float, boolean, else a string.

@@ -23,9 +23,10 @@ pub fn resolver(script_dir: Option<&Path>) -> ModuleResolversCollection {
     let mut engine = Engine::new();
     engine.set_max_operations(10_000_000);
     for (name, source) in MODULES {
-        let ast = engine
+        let mut ast = engine
             .compile(source)
             .unwrap_or_else(|e| panic!("std-lib module '{name}' does not compile: {e}"));
+        ast.set_source(format!("std-lib/{name}.rhai"));
         let module = Module::eval_ast_as_new(Scope::new(), &ast, &engine)
             .unwrap_or_else(|e| panic!("std-lib module '{name}' fails to load: {e}"));
         stat.insert(*name, module);

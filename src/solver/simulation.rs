@@ -205,6 +205,11 @@ impl Simulation {
         }
     }
 
+    /// How many symbolic LU analyses were done: one per sparsity pattern, not per iteration.
+    pub fn symbolic_analyses(&self) -> usize {
+        self.linear.symbolic_count
+    }
+
     /// Committed unknowns [u, lambda].
     pub fn unknowns(&self) -> &[f64] {
         &self.x
@@ -415,7 +420,13 @@ impl Simulation {
                 // The converged force on the tool is F_equi (= lambda for the mixed method).
                 s.lambda = res.f_equi;
                 s.status = res.status;
-                if let Some(p) = proj {
+                // With a frozen frame the operator saw the tangent plane; the committed
+                // geometry is the true projection on the tool.
+                let true_proj = match self.model.settings.contact.frame {
+                    FrameUpdate::Frozen => contact.tool.project(&pose, &xn, s.hint.as_ref()),
+                    FrameUpdate::EveryIteration => *proj,
+                };
+                if let Some(p) = true_proj {
                     s.hint = Some(p.hint);
                     s.gap = p.gap;
                     s.normal = p.normal;
