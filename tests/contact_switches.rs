@@ -5,7 +5,7 @@
 mod common;
 
 use tribo::contact::{ContactStatus, Enforcement, FrameUpdate};
-use tribo::geometry::{Cylinder, Plane, Vec3};
+use tribo::geometry::{Plane, Vec3};
 use tribo::mesh::Mesh;
 use tribo::solver::{Model, Simulation};
 use tribo::tool::ScalarSchedule;
@@ -97,27 +97,7 @@ fn frozen_frame_is_exact_on_a_plane() {
 #[test]
 fn frozen_frame_on_a_cylinder_leaves_a_gap_error_of_the_order_of_the_curvature() {
     let run = |frame| {
-        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(16.0, 1.0, 4.0), [32, 1, 8]).unwrap();
-        let mut model = Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
-        let cyl = Cylinder::new(Vec3::new(4.0, 0.0, 9.02), Vec3::y(), 5.0).unwrap();
-        let path = [
-            (0.0, [0.0; 3]),
-            (1.0, [0.0, 0.0, -0.12]),
-            (3.0, [8.0, 0.0, -0.12]),
-        ];
-        model
-            .add_tool(common::tool("roller", cyl, &path, 0.2), "z+", None)
-            .unwrap();
-        model
-            .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
-            .unwrap();
-        model
-            .prescribe("y-", "y", ScalarSchedule::constant(0.0))
-            .unwrap();
-        model
-            .prescribe("y+", "y", ScalarSchedule::constant(0.0))
-            .unwrap();
-        model.settings.end_time = 3.0;
+        let mut model = common::cylinder_drag_model(16.0, 4.0, 32, 8.0);
         model.settings.increments = 12;
         model.settings.contact.frame = frame;
         let mut sim = Simulation::new(model).unwrap();

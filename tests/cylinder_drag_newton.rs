@@ -7,41 +7,15 @@
 
 mod common;
 
-use tribo::geometry::{Cylinder, Vec3};
-use tribo::mesh::Mesh;
 use tribo::solver::{Model, Simulation};
-use tribo::tool::schedule::ScalarSchedule;
 
-const RADIUS: f64 = 5.0;
-const DEPTH: f64 = 0.1;
 const DRAG: f64 = 8.0;
 /// Relative residuals below this are round-off. Values just above it may carry some noise,
 /// which can only make an order estimate smaller: the assertion errs on the strict side.
 const NOISE_FLOOR: f64 = 1e-15;
 
 fn drag_model(curvature: bool) -> Model {
-    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(16.0, 1.0, 4.0), [32, 1, 8]).unwrap();
-    let mut model = Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
-    let axis_z = 4.0 + RADIUS + 0.02;
-    let cyl = Cylinder::new(Vec3::new(4.0, 0.0, axis_z), Vec3::y(), RADIUS).unwrap();
-    let path = [
-        (0.0, [0.0, 0.0, 0.0]),
-        (1.0, [0.0, 0.0, -0.02 - DEPTH]),
-        (3.0, [DRAG, 0.0, -0.02 - DEPTH]),
-    ];
-    model
-        .add_tool(common::tool("roller", cyl, &path, 0.2), "z+", None)
-        .unwrap();
-    model
-        .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
-        .unwrap();
-    model
-        .prescribe("y-", "y", ScalarSchedule::constant(0.0))
-        .unwrap();
-    model
-        .prescribe("y+", "y", ScalarSchedule::constant(0.0))
-        .unwrap();
-    model.settings.end_time = 3.0;
+    let mut model = common::cylinder_drag_model(16.0, 4.0, 32, DRAG);
     model.settings.increments = 6;
     model.settings.max_iterations = 40;
     model.settings.max_cutbacks = 0;

@@ -4,35 +4,12 @@
 
 mod common;
 
-use tribo::geometry::{Cylinder, Vec3};
-use tribo::mesh::Mesh;
 use tribo::solver::linear::{FaerLu, LinearSolver};
-use tribo::solver::{Model, Simulation};
-use tribo::tool::ScalarSchedule;
+use tribo::solver::Simulation;
 
 #[test]
 fn assembled_jacobian_matches_finite_differences() {
-    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(8.0, 1.0, 2.0), [16, 1, 4]).unwrap();
-    let mut model = Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
-    let cyl = Cylinder::new(Vec3::new(2.0, 0.0, 7.02), Vec3::y(), 5.0).unwrap();
-    let path = [
-        (0.0, [0.0; 3]),
-        (1.0, [0.0, 0.0, -0.12]),
-        (3.0, [4.0, 0.0, -0.12]),
-    ];
-    model
-        .add_tool(common::tool("roller", cyl, &path, 0.2), "z+", None)
-        .unwrap();
-    model
-        .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
-        .unwrap();
-    model
-        .prescribe("y-", "y", ScalarSchedule::constant(0.0))
-        .unwrap();
-    model
-        .prescribe("y+", "y", ScalarSchedule::constant(0.0))
-        .unwrap();
-    model.settings.end_time = 3.0;
+    let mut model = common::cylinder_drag_model(8.0, 2.0, 16, 4.0);
     model.settings.increments = 12;
     let mut sim = Simulation::new(model).unwrap();
     for _ in 0..7 {
