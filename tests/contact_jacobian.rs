@@ -36,11 +36,7 @@ fn residual(
 
 /// Worst relative mismatch between the analytic Jacobian and central differences.
 fn fd_mismatch(tool: &Tool, x: Vec3, l: Vec3, xr: Vec3, expect: ContactStatus) -> f64 {
-    let p = OperatorParams {
-        r: 80.0,
-        mu: 0.3,
-        curvature: true,
-    };
+    let p = OperatorParams::fixed_mu(80.0, 0.3, true);
     let pose = tool.pose(0.5);
     let proj = tool.project(&pose, &x, None).unwrap();
     let res = alart_curnier(&x, &xr, &l, &proj, &p);

@@ -4,7 +4,7 @@ pub mod friction;
 pub mod operator;
 pub mod state;
 
-pub use friction::FrictionLaw;
+pub use friction::{BernsteinLaw, FrictionInput, FrictionLaw, FrictionUpdate, WorkMeasure};
 pub use operator::{alart_curnier, ContactStatus, NodalContact, OperatorParams};
 pub use state::ContactNodeState;
 
@@ -37,6 +37,8 @@ pub struct ContactSettings {
     pub frame: FrameUpdate,
     /// Include curvature (normal gradient) terms in the Jacobian.
     pub curvature: bool,
+    /// Explicit (paper) or implicit (trapezoidal, in the Newton loop) friction update.
+    pub friction_update: FrictionUpdate,
 }
 
 impl Default for ContactSettings {
@@ -45,6 +47,7 @@ impl Default for ContactSettings {
             enforcement: Enforcement::AugmentedLagrangian,
             frame: FrameUpdate::EveryIteration,
             curvature: true,
+            friction_update: FrictionUpdate::Explicit,
         }
     }
 }

@@ -89,6 +89,23 @@ pub struct OperatorParams {
     pub mu: f64,
     /// Include the normal-gradient (curvature) terms in the Jacobian.
     pub curvature: bool,
+    /// Gradient of mu with respect to x and lambda when mu depends on the increment's own
+    /// frictional work (implicit friction update); zero otherwise.
+    pub dmu_dx: Vec3,
+    pub dmu_dlambda: Vec3,
+}
+
+impl OperatorParams {
+    /// Parameters with mu held fixed during the increment.
+    pub fn fixed_mu(r: f64, mu: f64, curvature: bool) -> Self {
+        OperatorParams {
+            r,
+            mu,
+            curvature,
+            dmu_dx: Vec3::zeros(),
+            dmu_dlambda: Vec3::zeros(),
+        }
+    }
 }
 
 /// Evaluates the operator at `x`, `lambda` for the projection `proj` of `x` on the tool.
@@ -99,7 +116,9 @@ pub fn alart_curnier(
     proj: &Projection,
     params: &OperatorParams,
 ) -> NodalContact {
-    let OperatorParams { r, mu, curvature } = *params;
+    let OperatorParams {
+        r, mu, curvature, ..
+    } = *params;
     let n = proj.normal;
     let d = proj.gap;
     let g_mat = if curvature {
@@ -140,8 +159,13 @@ pub fn alart_curnier(
         let dt_l = proj_t * dsigma_t_l;
         let n_mu_t = n - t * mu;
         let f = n_mu_t * sigma_n;
-        let fx = n_mu_t * dsigma_n_x + g_mat * sigma_n - dt_x * (mu * sigma_n);
-        let fl = n_mu_t * n.transpose() - dt_l * (mu * sigma_n);
+        // With an implicit friction update mu itself varies: - sigma_n t (dmu)^T.
+        let fx = n_mu_t * dsigma_n_x + g_mat * sigma_n
+            - dt_x * (mu * sigma_n)
+            - t * params.dmu_dx.transpose() * sigma_n;
+        let fl = n_mu_t * n.transpose()
+            - dt_l * (mu * sigma_n)
+            - t * params.dmu_dlambda.transpose() * sigma_n;
         (ContactStatus::Slip, f, fx, fl)
     };
 
@@ -175,11 +199,7 @@ mod tests {
             normal_gradient: Mat3::zeros(),
             hint: SurfaceHint::default(),
         };
-        let p = OperatorParams {
-            r: 10.0,
-            mu: 0.25,
-            curvature: true,
-        };
+        let p = OperatorParams::fixed_mu(10.0, 0.25, true);
         let lambda = Vec3::new(0.25 * 4.0, 0.0, -4.0);
         let x = Vec3::new(0.3, 0.0, 0.0);
         let res = alart_curnier(&x, &Vec3::zeros(), &lambda, &proj, &p);

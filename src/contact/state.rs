@@ -22,6 +22,10 @@ pub struct ContactNodeState {
     pub work: f64,
     /// Accumulated slip length sum |delta_t| over increments in contact.
     pub slip: f64,
+    /// theta of a work-dependent law (0 for other laws).
+    pub theta: f64,
+    /// How many times the committed status switched between stick and slip.
+    pub flips: usize,
     /// Friction coefficient to use in the next increment.
     pub mu: f64,
 }

@@ -38,6 +38,18 @@ impl RunOutput {
                 columns.push(format!("{}_force_{axis}", c.tool.name));
             }
         }
+        for c in &sim.model.contacts {
+            columns.push(format!("{}_frictional_dissipation", c.tool.name));
+        }
+        for name in [
+            "tool_work",
+            "load_work",
+            "support_work",
+            "elastic_energy",
+            "energy_balance_error",
+        ] {
+            columns.push(name.to_string());
+        }
         let history = HistoryCsv::create(folder.resolve_for_write("history.csv")?, &columns)?;
         Ok(RunOutput {
             folder,
@@ -68,6 +80,15 @@ impl RunOutput {
         for f in &r.tool_forces {
             row.extend_from_slice(f);
         }
+        let e = &r.energy;
+        row.extend_from_slice(&e.frictional_dissipation);
+        row.extend_from_slice(&[
+            e.tool_work,
+            e.load_work,
+            e.support_work,
+            e.elastic_energy,
+            e.relative_error,
+        ]);
         self.history.append(&row)
     }
 
@@ -101,6 +122,8 @@ impl RunOutput {
                         "final_force": [f.x, f.y, f.z],
                         "surface": contact.tool.surface.describe(),
                         "friction": contact.tool.friction.describe(),
+                        "work_measure": contact.tool.friction.bernstein().map(|l| l.measure().name()),
+                        "frictional_dissipation": sim.energy().frictional_dissipation.get(c),
                         "candidate_nodes": contact.candidates.len(),
                     }),
                 )
@@ -129,7 +152,9 @@ impl RunOutput {
                 "enforcement": format!("{:?}", settings.contact.enforcement),
                 "frame": format!("{:?}", settings.contact.frame),
                 "curvature_terms": settings.contact.curvature,
+                "friction_update": format!("{:?}", settings.contact.friction_update),
             },
+            "energy": sim.energy(),
             "tools": tools,
             "frames": self.frames,
         });
@@ -152,6 +177,8 @@ pub fn frame(sim: &Simulation) -> Frame {
     let mut work = vec![0.0; n];
     let mut slip = vec![0.0; n];
     let mut mu = vec![0.0; n];
+    let mut theta = vec![0.0; n];
+    let mut flips = vec![0.0; n];
     for (c, contact) in sim.model.contacts.iter().enumerate() {
         for (k, s) in sim.contact_states(c).iter().enumerate() {
             let node = contact.candidates[k];
@@ -168,7 +195,9 @@ pub fn frame(sim: &Simulation) -> Frame {
                     -ln / contact.areas[k].max(f64::MIN_POSITIVE)
                 };
                 mu[node] = s.mu;
+                theta[node] = s.theta;
             }
+            flips[node] += s.flips as f64;
             work[node] += s.work;
             slip[node] = f64::max(slip[node], s.slip);
         }
@@ -206,6 +235,8 @@ pub fn frame(sim: &Simulation) -> Frame {
             Field::scalar("frictional_work", work),
             Field::scalar("accumulated_slip", slip),
             Field::scalar("mu", mu),
+            Field::scalar("theta", theta),
+            Field::scalar("stick_slip_flips", flips),
         ],
         cell_data: vec![
             Field::new("stress", 6, stress),

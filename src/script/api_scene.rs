@@ -2,7 +2,7 @@
 //! tools. Registered in one place; scripts see only these functions.
 
 use super::convert::*;
-use crate::contact::FrictionLaw;
+use crate::contact::{BernsteinLaw, FrictionLaw, WorkMeasure};
 use crate::geometry::{Cylinder, Plane, RigidSurface, Sphere};
 use crate::material::{LinearElastic, Material};
 use crate::mesh::{End, Grading, Mesh};
@@ -19,10 +19,76 @@ pub struct ScriptMaterial(pub Arc<dyn Material>);
 #[derive(Clone, Debug)]
 pub struct ScriptSurface(pub Arc<dyn RigidSurface>);
 
-pub fn register(engine: &mut Engine) {
+pub fn register(engine: &mut Engine, host: std::rc::Rc<super::HostOptions>) {
     register_mesh(engine);
     register_material(engine);
     register_tools(engine);
+    register_friction(engine, host);
+}
+
+fn work_measure(name: &str) -> ScriptResult<WorkMeasure> {
+    match name {
+        "per_node" => Ok(WorkMeasure::PerNode),
+        "per_area" => Ok(WorkMeasure::PerArea),
+        other => runtime_error(format!(
+            "work measure '{other}' must be \"per_node\" or \"per_area\""
+        )),
+    }
+}
+
+fn register_friction(engine: &mut Engine, host: std::rc::Rc<super::HostOptions>) {
+    // bernstein([P0, ..., Pm], work_cut [, "per_node" | "per_area"])
+    engine.register_fn(
+        "bernstein",
+        |points: Array, work_cut: Dynamic| -> ScriptResult<FrictionLaw> {
+            let p = points
+                .iter()
+                .map(|v| number(v, "Bernstein control point"))
+                .collect::<ScriptResult<Vec<f64>>>()?;
+            Ok(FrictionLaw::Bernstein(lift(BernsteinLaw::new(
+                p,
+                number(&work_cut, "work_cut")?,
+                WorkMeasure::PerNode,
+            ))?))
+        },
+    );
+    engine.register_fn(
+        "bernstein",
+        |points: Array, work_cut: Dynamic, measure: &str| -> ScriptResult<FrictionLaw> {
+            let p = points
+                .iter()
+                .map(|v| number(v, "Bernstein control point"))
+                .collect::<ScriptResult<Vec<f64>>>()?;
+            let law = BernsteinLaw::new(p, number(&work_cut, "work_cut")?, work_measure(measure)?);
+            Ok(FrictionLaw::Bernstein(lift(law)?))
+        },
+    );
+    // mu(theta) of a law, for plotting or checking: law.mu_at(theta)
+    engine.register_fn(
+        "mu_at",
+        |law: &mut FrictionLaw, theta: f64| -> ScriptResult<f64> {
+            match law {
+                FrictionLaw::Bernstein(l) => Ok(l.mu_of_theta(theta.clamp(0.0, 1.0))),
+                FrictionLaw::Coulomb { mu } => Ok(*mu),
+                _ => runtime_error("mu_at needs a Coulomb or Bernstein law"),
+            }
+        },
+    );
+    // tool.friction(|work, slip, pressure| mu): a script function of the node's state,
+    // called once per contact node after each converged increment.
+    engine.register_fn(
+        "friction",
+        move |ctx: NativeCallContext, t: &mut Tool, law: FnPtr| -> ScriptResult<Tool> {
+            let initial = law.call_within_context::<f64>(&ctx, (0.0, 0.0, 0.0))?;
+            lift(crate::contact::friction::check_mu(
+                &format!("friction function of tool '{}' at zero work", t.name),
+                initial,
+            ))?;
+            host.script_laws.borrow_mut().insert(t.name.clone(), law);
+            t.friction = FrictionLaw::External { initial };
+            Ok(t.clone())
+        },
+    );
 }
 
 fn parse_grading(spec: &Map) -> ScriptResult<[Grading; 3]> {

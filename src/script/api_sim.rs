@@ -4,12 +4,13 @@ use super::api_scene::{scalar_schedule, ScriptMaterial};
 use super::convert::*;
 use super::HostOptions;
 use crate::contact::{Enforcement, FrameUpdate};
+use crate::contact::{FrictionInput, FrictionLaw};
 use crate::mesh::Mesh;
 use crate::output::RunOutput;
 use crate::solver::{IncrementReport, Model, Simulation};
 use crate::tool::Tool;
 use crate::Error;
-use rhai::{Array, Dynamic, Engine, Map};
+use rhai::{Array, Dynamic, Engine, FnPtr, Map, NativeCallContext};
 use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Instant;
@@ -22,6 +23,46 @@ pub struct SimState {
     output_every: usize,
     host: Rc<HostOptions>,
     started: Option<Instant>,
+    /// Per converged increment: (index, time, per tool, per candidate [work, mu, status]).
+    node_log: Vec<NodeSnapshot>,
+}
+
+type NodeSnapshot = (usize, f64, Vec<Vec<[f64; 3]>>);
+
+/// One increment with script friction laws applied: the simulation is not borrowed while
+/// a script function runs (it may itself query the simulation).
+fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementReport> {
+    let report = s.borrow_mut().step_once()?;
+    let pending: Vec<(usize, FnPtr, Vec<FrictionInput>)> = {
+        let st = s.borrow();
+        let sim = st.sim.as_ref().expect("started");
+        let laws = st.host.script_laws.borrow();
+        sim.model
+            .contacts
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| matches!(c.tool.friction, FrictionLaw::External { .. }))
+            .filter_map(|(i, c)| {
+                laws.get(&c.tool.name)
+                    .map(|f| (i, f.clone(), sim.friction_inputs(i)))
+            })
+            .collect()
+    };
+    for (c, law, inputs) in pending {
+        let mu = inputs
+            .iter()
+            .map(|q| law.call_within_context::<f64>(ctx, (q.work, q.slip, q.pressure)))
+            .collect::<ScriptResult<Vec<f64>>>()?;
+        lift(
+            s.borrow_mut()
+                .sim
+                .as_mut()
+                .expect("started")
+                .set_friction_coefficients(c, &mu),
+        )?;
+    }
+    s.borrow_mut().record_step(&report)?;
+    Ok(report)
 }
 
 /// Shared handle: Rhai values are clones of it.
@@ -55,21 +96,13 @@ impl SimState {
         Ok(self.sim.as_mut().expect("just set"))
     }
 
+    /// Solves one increment. On failure the summary records why; every frame already
+    /// written stays.
     fn step_once(&mut self) -> ScriptResult<IncrementReport> {
-        let every = self.output_every;
         self.simulation()?;
         let sim = self.sim.as_mut().expect("started");
-        let result = sim.step();
-        match result {
-            Ok(report) => {
-                if let Some(out) = self.output.as_mut() {
-                    lift(out.record(sim, &report))?;
-                    if every > 0 && (report.index % every == 0 || sim.is_finished()) {
-                        lift(out.write_frame(sim))?;
-                    }
-                }
-                Ok(report)
-            }
+        match sim.step() {
+            Ok(report) => Ok(report),
             Err(err) => {
                 if let Some(out) = self.output.as_mut() {
                     let wall = self
@@ -81,6 +114,28 @@ impl SimState {
                 fail(err)
             }
         }
+    }
+
+    /// Writes the increment's outputs and keeps each contact node's history.
+    fn record_step(&mut self, report: &IncrementReport) -> ScriptResult<()> {
+        let every = self.output_every;
+        let sim = self.sim.as_ref().expect("started");
+        if let Some(out) = self.output.as_mut() {
+            lift(out.record(sim, report))?;
+            if every > 0 && (report.index % every == 0 || sim.is_finished()) {
+                lift(out.write_frame(sim))?;
+            }
+        }
+        let snapshot = (0..sim.model.contacts.len())
+            .map(|c| {
+                sim.contact_states(c)
+                    .iter()
+                    .map(|s| [s.work, s.mu, s.status.code()])
+                    .collect()
+            })
+            .collect();
+        self.node_log.push((report.index, report.time, snapshot));
+        Ok(())
     }
 
     fn finish(&mut self) -> ScriptResult<()> {
@@ -146,6 +201,13 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
             "force_abs_tolerance" => s.force_abs_tol = num("force_abs_tolerance")?,
             "contact_tolerance" => s.contact_tol = num("contact_tolerance")?,
             "output_every" => *st = num("output_every")? as usize,
+            "friction_update" => {
+                s.contact.friction_update = match v.clone().into_string().unwrap_or_default().as_str() {
+                    "explicit" => crate::contact::FrictionUpdate::Explicit,
+                    "implicit" => crate::contact::FrictionUpdate::Implicit,
+                    o => return runtime_error(format!("friction_update = '{o}' must be \"explicit\" or \"implicit\"")),
+                }
+            }
             "curvature" => {
                 s.contact.curvature = v.as_bool().map_err(|t| format!("curvature must be true or false, got {t}")).or_else(runtime_error)?
             }
@@ -169,7 +231,7 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, curvature, frame, enforcement)"
+                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, curvature, frame, enforcement, friction_update)"
                 ))
             }
         }
@@ -208,6 +270,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 output_every: 1,
                 host: h.clone(),
                 started: None,
+                node_log: Vec::new(),
             })))
         },
     );
@@ -271,65 +334,73 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             Ok(())
         },
     );
-    engine.register_fn("step", |s: &mut ScriptSim| -> ScriptResult<Map> {
-        let mut st = s.borrow_mut();
-        let r = st.step_once()?;
-        if st.sim.as_ref().is_some_and(|x| x.is_finished()) {
-            st.finish()?;
-        }
-        Ok(report_map(&r, &tool_names(&st)))
-    });
-    let h = host.clone();
-    engine.register_fn("run", move |s: &mut ScriptSim| -> ScriptResult<Map> {
-        if h.defer_run.get() {
-            println!(
-                "(repl) sim.run() deferred: step with sim.step(), or call sim.run() to finish"
-            );
-            return Ok(Map::new());
-        }
-        let mut st = s.borrow_mut();
-        st.simulation()?;
-        let total = {
-            let sim = st.sim.as_ref().expect("started");
-            sim.model.settings.increments as u64
-        };
-        let bar = h.progress.then(|| {
-            let b = indicatif::ProgressBar::new(total);
-            b.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "{bar:40} {pos}/{len} increments  {msg}  [{elapsed_precise}]",
-                )
-                .expect("valid template"),
-            );
-            b
-        });
-        let mut last = None;
-        while !st.sim.as_ref().expect("started").is_finished() {
-            let r = match st.step_once() {
-                Ok(r) => r,
-                Err(e) => {
-                    if let Some(b) = &bar {
-                        b.abandon_with_message("stopped");
-                    }
-                    return Err(e);
-                }
-            };
-            if let Some(b) = &bar {
-                b.inc(1);
-                b.set_message(format!(
-                    "t = {:.4}, {} Newton iterations",
-                    r.time, r.iterations
-                ));
+    engine.register_fn(
+        "step",
+        |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> {
+            let r = advance(&ctx, s)?;
+            let mut st = s.borrow_mut();
+            if st.sim.as_ref().is_some_and(|x| x.is_finished()) {
+                st.finish()?;
             }
-            last = Some(r);
-        }
-        if let Some(b) = &bar {
-            b.finish();
-        }
-        st.finish()?;
-        let names = tool_names(&st);
-        Ok(last.map(|r| report_map(&r, &names)).unwrap_or_default())
-    });
+            Ok(report_map(&r, &tool_names(&st)))
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "run",
+        move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> {
+            if h.defer_run.get() {
+                println!(
+                    "(repl) sim.run() deferred: step with sim.step(), or call sim.run() to finish"
+                );
+                return Ok(Map::new());
+            }
+            let mut st = s.borrow_mut();
+            st.simulation()?;
+            let total = {
+                let sim = st.sim.as_ref().expect("started");
+                sim.model.settings.increments as u64
+            };
+            let bar = h.progress.then(|| {
+                let b = indicatif::ProgressBar::new(total);
+                b.set_style(
+                    indicatif::ProgressStyle::with_template(
+                        "{bar:40} {pos}/{len} increments  {msg}  [{elapsed_precise}]",
+                    )
+                    .expect("valid template"),
+                );
+                b
+            });
+            let mut last = None;
+            drop(st);
+            while !s.borrow().sim.as_ref().expect("started").is_finished() {
+                let r = match advance(&ctx, s) {
+                    Ok(r) => r,
+                    Err(e) => {
+                        if let Some(b) = &bar {
+                            b.abandon_with_message("stopped");
+                        }
+                        return Err(e);
+                    }
+                };
+                if let Some(b) = &bar {
+                    b.inc(1);
+                    b.set_message(format!(
+                        "t = {:.4}, {} Newton iterations",
+                        r.time, r.iterations
+                    ));
+                }
+                last = Some(r);
+            }
+            if let Some(b) = &bar {
+                b.finish();
+            }
+            let mut st = s.borrow_mut();
+            st.finish()?;
+            let names = tool_names(&st);
+            Ok(last.map(|r| report_map(&r, &names)).unwrap_or_default())
+        },
+    );
     engine.register_get("time", |s: &mut ScriptSim| {
         s.borrow().sim.as_ref().map(|x| x.time()).unwrap_or(0.0)
     });
@@ -414,6 +485,41 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 .find(|m| m.get("node").and_then(|v| v.as_int().ok()) == Some(node))
                 .ok_or_else(|| format!("node {node} is not a contact candidate of tool '{name}'"))
                 .or_else(runtime_error)
+        },
+    );
+    // A node's history against a tool: one map per converged increment.
+    engine.register_fn(
+        "node_history",
+        |s: &mut ScriptSim, name: &str, node: i64| -> ScriptResult<Array> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let c = lift(sim.model.tool_index(name))?;
+            let Some(k) = sim.model.contacts[c]
+                .candidates
+                .iter()
+                .position(|&n| n as i64 == node)
+            else {
+                return runtime_error(format!(
+                    "node {node} is not a contact candidate of tool '{name}'"
+                ));
+            };
+            Ok(st
+                .node_log
+                .iter()
+                .map(|(index, time, tools)| {
+                    let [work, mu, status] = tools[c][k];
+                    let mut m = Map::new();
+                    m.insert("increment".into(), Dynamic::from(*index as i64));
+                    m.insert("time".into(), Dynamic::from(*time));
+                    m.insert("work".into(), Dynamic::from(work));
+                    m.insert("mu".into(), Dynamic::from(mu));
+                    m.insert(
+                        "status".into(),
+                        Dynamic::from(["gap", "stick", "slip"][status as usize].to_string()),
+                    );
+                    Dynamic::from(m)
+                })
+                .collect())
         },
     );
     engine.register_fn("history", |s: &mut ScriptSim| -> Array {

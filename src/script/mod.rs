@@ -29,6 +29,8 @@ pub struct HostOptions {
     /// While set (the REPL loading its script), `sim.run()` returns at once so that the
     /// person can step the scene by hand.
     pub defer_run: Rc<std::cell::Cell<bool>>,
+    /// Script friction laws by tool name (`tool.friction(|work, slip, pressure| ...)`).
+    pub script_laws: Rc<std::cell::RefCell<std::collections::BTreeMap<String, rhai::FnPtr>>>,
 }
 
 impl Default for HostOptions {
@@ -38,6 +40,7 @@ impl Default for HostOptions {
             progress: false,
             max_operations: 50_000_000,
             defer_run: Rc::new(std::cell::Cell::new(false)),
+            script_laws: Rc::default(),
         }
     }
 }
@@ -53,7 +56,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.set_max_map_size(1 << 16);
     engine.set_module_resolver(stdlib::resolver(script_dir));
     let host = Rc::new(host.clone());
-    api_scene::register(&mut engine);
+    api_scene::register(&mut engine, host.clone());
     api_sim::register(&mut engine, host);
     register_checks(&mut engine);
     engine

@@ -14,7 +14,10 @@
 
 use super::model::Model;
 use super::sparse::{SparseMatrix, SparsePattern};
-use crate::contact::{alart_curnier, ContactNodeState, Enforcement, NodalContact, OperatorParams};
+use crate::contact::{
+    alart_curnier, BernsteinLaw, ContactNodeState, Enforcement, FrictionUpdate, NodalContact,
+    OperatorParams,
+};
 use crate::element::{in_element, Element, ElementResponse, Hex8};
 use crate::geometry::{Mat3, Projection, Vec3};
 use crate::material::PointState;
@@ -116,6 +119,9 @@ pub struct Evaluation {
     /// Internal forces (all dofs), for reactions and residual scaling.
     pub f_int: Vec<f64>,
     pub f_ext: Vec<f64>,
+    /// Force of the supports on the body at prescribed displacement components (zero
+    /// elsewhere): f_int - f_ext + contact at those rows.
+    pub support_forces: Vec<f64>,
 }
 
 /// Inputs that stay fixed during the Newton iterations of one increment.
@@ -206,16 +212,33 @@ impl IncrementContext<'_> {
                     }),
                     None => contact.tool.project(pose, &xn, committed.hint.as_ref()),
                 };
-                let params = OperatorParams {
-                    r: contact.r[k],
-                    mu: committed.mu,
-                    curvature: model.settings.contact.curvature,
-                };
                 let lam_dof = self.dofs.lambda_offset[c].map(|off| off + 3 * k);
                 let lambda = match lam_dof {
                     Some(l) => Vec3::new(x[l], x[l + 1], x[l + 2]),
                     None => Vec3::zeros(),
                 };
+                let mut params = OperatorParams::fixed_mu(
+                    contact.r[k],
+                    committed.mu,
+                    model.settings.contact.curvature,
+                );
+                if let (FrictionUpdate::Implicit, Some(law), Some(p), Some(_)) = (
+                    model.settings.contact.friction_update,
+                    contact.tool.friction.bernstein(),
+                    proj.as_ref(),
+                    lam_dof,
+                ) {
+                    implicit_mu(
+                        &mut params,
+                        law,
+                        committed,
+                        contact.areas[k],
+                        &xn,
+                        &x_ref,
+                        &lambda,
+                        p,
+                    );
+                }
                 let result = match (proj.as_ref(), lam_dof) {
                     (Some(p), Some(_)) => alart_curnier(&xn, &x_ref, &lambda, p, &params),
                     (Some(p), None) => penalty(&xn, &x_ref, committed, p, &params),
@@ -255,6 +278,9 @@ impl IncrementContext<'_> {
         }
         times.contact += t1.elapsed().as_secs_f64();
 
+        let support_forces: Vec<f64> = (0..3 * self.dofs.n_nodes)
+            .map(|d| if self.is_fixed[d] { residual[d] } else { 0.0 })
+            .collect();
         let mut unit = self.is_fixed.to_vec();
         for (d, fixed) in self.is_fixed.iter().enumerate() {
             if *fixed {
@@ -273,6 +299,7 @@ impl IncrementContext<'_> {
             nodal,
             f_int,
             f_ext,
+            support_forces,
         })
     }
 
@@ -325,4 +352,41 @@ fn penalty(
         res.equi_x += res.equi_lambda * dlambda_dx;
     }
     res
+}
+
+/// Implicit (trapezoidal) friction update: the increment's coefficient is the mean of mu at
+/// the committed work Psi_n and at the end-of-increment work Psi_n + lambda_t . delta_t,
+/// with lambda_t = P lambda, delta_t = P (x - x_ref), P = I - n n^T. Fills mu and its
+/// gradients:
+///
+/// ```text
+/// d(dPsi)/dlambda = delta_t
+/// d(dPsi)/dx      = lambda_t - (n.delta) G^T lambda - (n.lambda) G^T delta   (G = dn/dx)
+/// ```
+#[allow(clippy::too_many_arguments)]
+fn implicit_mu(
+    params: &mut OperatorParams,
+    law: &BernsteinLaw,
+    committed: &ContactNodeState,
+    area: f64,
+    x: &Vec3,
+    x_ref: &Vec3,
+    lambda: &Vec3,
+    proj: &Projection,
+) {
+    let n = proj.normal;
+    let delta = x - x_ref;
+    let lambda_t = lambda - n * n.dot(lambda);
+    let delta_t = delta - n * n.dot(&delta);
+    let work_end = committed.work + lambda_t.dot(&delta_t);
+    let theta = law.theta(work_end, area);
+    let slope = law.dmu_dtheta(theta) * law.dtheta_dwork(work_end, area);
+    params.mu = 0.5 * (committed.mu + law.mu_of_theta(theta));
+    let mut dwork_dx = lambda_t;
+    if params.curvature {
+        let gt = proj.normal_gradient.transpose();
+        dwork_dx -= gt * lambda * n.dot(&delta) + gt * delta * n.dot(lambda);
+    }
+    params.dmu_dx = dwork_dx * (0.5 * slope);
+    params.dmu_dlambda = delta_t * (0.5 * slope);
 }

@@ -7,7 +7,7 @@ use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTi
 use super::linear::{FaerLu, LinearSolver};
 use super::model::Model;
 use super::sparse::SparsePattern;
-use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate};
+use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
 use crate::element::{Element, Hex8};
 use crate::geometry::Vec3;
 use crate::material::PointState;
@@ -42,6 +42,8 @@ pub struct IncrementReport {
     pub tool_forces: Vec<[f64; 3]>,
     pub active_nodes: usize,
     pub slipping_nodes: usize,
+    /// Energy balance after this increment.
+    pub energy: EnergyBalance,
 }
 
 /// Model plus its evolving, committed solution.
@@ -59,6 +61,8 @@ pub struct Simulation {
     increments_done: usize,
     pub history: Vec<IncrementReport>,
     pub phase_times: PhaseTimes,
+    energy: EnergyBalance,
+    energy_memory: EnergyMemory,
 }
 
 impl Simulation {
@@ -91,8 +95,9 @@ impl Simulation {
                 let pose = c.tool.pose(0.0);
                 c.candidates
                     .iter()
-                    .map(|&node| {
-                        let x0 = model.mesh.nodes[node];
+                    .zip(&c.areas)
+                    .map(|(node, area)| {
+                        let x0 = model.mesh.nodes[*node];
                         let mut s = ContactNodeState {
                             x_ref_local: pose.to_local(&x0),
                             ..Default::default()
@@ -102,12 +107,25 @@ impl Simulation {
                             s.gap = p.gap;
                             s.normal = p.normal;
                         }
-                        s.mu = c.tool.friction.mu(&s);
+                        s.mu = c.tool.friction.initial_mu(*area);
                         s
                     })
                     .collect()
             })
             .collect();
+        let dofs_nodes = dofs.n_nodes;
+        let initial_f_ext = {
+            let mut f = vec![0.0; 3 * dofs_nodes];
+            for load in &model.loads {
+                let total = load.total * load.scale.value(0.0);
+                for (&node, &w) in load.nodes.iter().zip(&load.weights) {
+                    for i in 0..3 {
+                        f[3 * node + i] += w * total[i];
+                    }
+                }
+            }
+            f
+        };
         Ok(Simulation {
             x: vec![0.0; dofs.n_dofs],
             dofs,
@@ -120,6 +138,15 @@ impl Simulation {
             increments_done: 0,
             history: Vec::new(),
             phase_times: PhaseTimes::default(),
+            energy: EnergyBalance {
+                frictional_dissipation: vec![0.0; model.contacts.len()],
+                ..Default::default()
+            },
+            energy_memory: EnergyMemory {
+                support_forces: vec![0.0; 3 * dofs_nodes],
+                external_forces: initial_f_ext,
+                tool_forces: vec![Vec3::zeros(); model.contacts.len()],
+            },
             model,
         })
     }
@@ -408,6 +435,7 @@ impl Simulation {
         residuals: Vec<IterationRecord>,
     ) -> IncrementReport {
         let mut tool_forces = Vec::new();
+        let mut dissipated = vec![0.0; self.model.contacts.len()];
         let (mut active, mut slipping) = (0, 0);
         for (c, contact) in self.model.contacts.iter().enumerate() {
             let pose = contact.tool.pose(t_new);
@@ -415,6 +443,7 @@ impl Simulation {
             for (k, &node) in contact.candidates.iter().enumerate() {
                 let (res, proj) = &eval.nodal[c][k];
                 let s = &mut self.contact[c][k];
+                let previous_status = s.status;
                 let xn = self.model.mesh.nodes[node]
                     + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
                 // The converged force on the tool is F_equi (= lambda for the mixed method).
@@ -433,17 +462,41 @@ impl Simulation {
                 }
                 if res.status.is_active() {
                     let lambda_t = s.lambda - s.normal * s.lambda.dot(&s.normal);
-                    s.work += lambda_t.dot(&res.slip_increment).max(0.0);
+                    let dwork = lambda_t.dot(&res.slip_increment).max(0.0);
+                    s.work += dwork;
+                    dissipated[c] += dwork;
                     s.slip += res.slip_increment.norm();
+                }
+                let stick_slip = |st: ContactStatus| st.is_active();
+                if stick_slip(previous_status)
+                    && stick_slip(res.status)
+                    && previous_status != res.status
+                {
+                    s.flips += 1;
                 }
                 active += usize::from(res.status.is_active());
                 slipping += usize::from(res.status == ContactStatus::Slip);
                 s.x_ref_local = pose.to_local(&xn);
-                s.mu = contact.tool.friction.mu(s);
+                let area = contact.areas[k];
+                let input = FrictionInput {
+                    work: s.work,
+                    slip: s.slip,
+                    pressure: -s.lambda_n() / area.max(f64::MIN_POSITIVE),
+                    area,
+                };
+                if let Some(mu) = contact.tool.friction.mu(&input) {
+                    s.mu = mu;
+                }
+                s.theta = contact
+                    .tool
+                    .friction
+                    .bernstein()
+                    .map_or(0.0, |law| law.theta(s.work, area));
                 total += s.lambda;
             }
             tool_forces.push([total.x, total.y, total.z]);
         }
+        let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated);
         self.x = x;
         self.points = eval.trial_points;
         let dt = t_new - self.time;
@@ -459,8 +512,127 @@ impl Simulation {
             tool_forces,
             active_nodes: active,
             slipping_nodes: slipping,
+            energy,
         }
     }
+
+    /// Updates the energy balance with one converged increment (trapezoidal rule for the
+    /// work of tools, loads and supports; the elastic energy is a state function; the
+    /// frictional dissipation is the sum of the nodal work increments).
+    fn account_energy(
+        &mut self,
+        t_new: f64,
+        x: &[f64],
+        eval: &Evaluation,
+        tool_forces: &[[f64; 3]],
+        dissipated: &[f64],
+    ) -> EnergyBalance {
+        let n_u = 3 * self.dofs.n_nodes;
+        let e = &mut self.energy;
+        let last = &self.energy_memory;
+        for d in 0..n_u {
+            let du = x[d] - self.x[d];
+            e.support_work += 0.5 * (last.support_forces[d] + eval.support_forces[d]) * du;
+            e.load_work += 0.5 * (last.external_forces[d] + eval.f_ext[d]) * du;
+        }
+        for (c, contact) in self.model.contacts.iter().enumerate() {
+            let travel = contact.tool.schedule.translation(t_new)
+                - contact.tool.schedule.translation(self.time);
+            let force = Vec3::from(tool_forces[c]);
+            // The body pushes the tool with +lambda, the tool the body with -lambda.
+            e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);
+            e.frictional_dissipation[c] += dissipated[c];
+        }
+        e.elastic_energy = crate::element::total_strain_energy(
+            &self.model.mesh,
+            &Hex8,
+            &eval.trial_points,
+            self.model.material.as_ref(),
+        )
+        .unwrap_or(f64::NAN);
+        let input = e.tool_work + e.load_work + e.support_work;
+        let stored: f64 = e.elastic_energy + e.frictional_dissipation.iter().sum::<f64>();
+        let scale =
+            (e.tool_work.abs() + e.load_work.abs() + e.support_work.abs()).max(stored.abs());
+        e.relative_error = if scale > 0.0 {
+            (input - stored) / scale
+        } else {
+            0.0
+        };
+        self.energy_memory = EnergyMemory {
+            support_forces: eval.support_forces.clone(),
+            external_forces: eval.f_ext.clone(),
+            tool_forces: tool_forces.iter().map(|f| Vec3::from(*f)).collect(),
+        };
+        e.clone()
+    }
+
+    /// The energy balance so far.
+    pub fn energy(&self) -> &EnergyBalance {
+        &self.energy
+    }
+
+    /// Friction inputs (work, slip, pressure, area) of every candidate node of tool `c`.
+    pub fn friction_inputs(&self, c: usize) -> Vec<FrictionInput> {
+        let contact = &self.model.contacts[c];
+        self.contact[c]
+            .iter()
+            .zip(&contact.areas)
+            .map(|(s, &area)| FrictionInput {
+                work: s.work,
+                slip: s.slip,
+                pressure: -s.lambda_n() / area.max(f64::MIN_POSITIVE),
+                area,
+            })
+            .collect()
+    }
+
+    /// Sets the friction coefficients of tool `c`'s nodes for the next increment (for laws
+    /// evaluated outside the library, such as script functions). Values must be >= 0.
+    pub fn set_friction_coefficients(&mut self, c: usize, mu: &[f64]) -> Result<()> {
+        if mu.len() != self.contact[c].len() {
+            return Err(Error::Input(format!(
+                "{} friction coefficients given for {} contact nodes",
+                mu.len(),
+                self.contact[c].len()
+            )));
+        }
+        for (k, &m) in mu.iter().enumerate() {
+            crate::contact::friction::check_mu(
+                &format!("friction coefficient of contact node {k}"),
+                m,
+            )?;
+        }
+        for (s, &m) in self.contact[c].iter_mut().zip(mu) {
+            s.mu = m;
+        }
+        Ok(())
+    }
+}
+
+/// Energy bookkeeping of a run, cumulative from t = 0.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct EnergyBalance {
+    /// Work done on the body by the tools' motion.
+    pub tool_work: f64,
+    /// Work of the applied loads.
+    pub load_work: f64,
+    /// Work of the supports at prescribed (non-zero) displacements.
+    pub support_work: f64,
+    /// Elastic energy stored in the body now.
+    pub elastic_energy: f64,
+    /// Frictional dissipation per tool (the sum of its nodes' frictional work).
+    pub frictional_dissipation: Vec<f64>,
+    /// (work in - stored - dissipated) / scale.
+    pub relative_error: f64,
+}
+
+/// Forces at the end of the last increment, for the trapezoidal rule.
+#[derive(Clone, Debug, Default)]
+struct EnergyMemory {
+    support_forces: Vec<f64>,
+    external_forces: Vec<f64>,
+    tool_forces: Vec<Vec3>,
 }
 
 fn norm(v: &[f64]) -> f64 {
