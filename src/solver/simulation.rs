@@ -446,6 +446,10 @@ impl Simulation {
                 let previous_status = s.status;
                 let xn = self.model.mesh.nodes[node]
                     + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+                // Work of the contact force on the relative motion, by the trapezoidal rule
+                // like every other work term (Psi below follows the paper instead).
+                let relative_motion = xn - pose.to_global_point(&s.x_ref_local);
+                dissipated[c] += 0.5 * (s.lambda + res.f_equi).dot(&relative_motion);
                 // The converged force on the tool is F_equi (= lambda for the mixed method).
                 s.lambda = res.f_equi;
                 s.status = res.status;
@@ -462,9 +466,7 @@ impl Simulation {
                 }
                 if res.status.is_active() {
                     let lambda_t = s.lambda - s.normal * s.lambda.dot(&s.normal);
-                    let dwork = lambda_t.dot(&res.slip_increment).max(0.0);
-                    s.work += dwork;
-                    dissipated[c] += dwork;
+                    s.work += lambda_t.dot(&res.slip_increment).max(0.0);
                     s.slip += res.slip_increment.norm();
                 }
                 let stick_slip = |st: ContactStatus| st.is_active();
@@ -516,9 +518,9 @@ impl Simulation {
         }
     }
 
-    /// Updates the energy balance with one converged increment (trapezoidal rule for the
-    /// work of tools, loads and supports; the elastic energy is a state function; the
-    /// frictional dissipation is the sum of the nodal work increments).
+    /// Updates the energy balance with one converged increment: trapezoidal rule for the
+    /// work of tools, loads, supports and for the frictional dissipation; the elastic energy
+    /// is a state function.
     fn account_energy(
         &mut self,
         t_new: f64,
@@ -621,7 +623,12 @@ pub struct EnergyBalance {
     pub support_work: f64,
     /// Elastic energy stored in the body now.
     pub elastic_energy: f64,
-    /// Frictional dissipation per tool (the sum of its nodes' frictional work).
+    /// Frictional dissipation per tool: the work of the contact forces on the slip,
+    /// 1/2 (lambda_n + lambda_{n+1}) . delta per node and increment, the same trapezoidal
+    /// rule as the other work terms, which makes the balance exact for elastic bodies. The
+    /// nodes' frictional work Psi (the friction law's variable) uses the paper's
+    /// lambda_{n+1} . delta_t and differs from it where the force changes within an
+    /// increment (a stick-slip transition, a changing mu).
     pub frictional_dissipation: Vec<f64>,
     /// (work in - stored - dissipated) / scale.
     pub relative_error: f64,
