@@ -9,7 +9,35 @@ use tribo::solver::Simulation;
 
 #[test]
 fn assembled_jacobian_matches_finite_differences() {
+    check(common::cylinder_drag_model(8.0, 2.0, 16, 4.0));
+}
+
+/// With the implicit friction update mu depends on the increment's own frictional work,
+/// lambda_t . delta_t: its gradient enters the slip rows (the softening Bernstein law,
+/// cut-off work chosen so that theta is mid-range).
+#[test]
+fn assembled_jacobian_with_implicit_friction_matches_finite_differences() {
+    use tribo::contact::{BernsteinLaw, FrictionLaw, FrictionUpdate, WorkMeasure};
     let mut model = common::cylinder_drag_model(8.0, 2.0, 16, 4.0);
+    let law =
+        BernsteinLaw::new(vec![0.3, 0.2, 0.05, 0.1, 0.02], 20.0, WorkMeasure::PerArea).unwrap();
+    model.contacts[0].tool.friction = FrictionLaw::Bernstein(law);
+    model.settings.contact.friction_update = FrictionUpdate::Implicit;
+    let sim = check(model);
+    let evolving = sim
+        .contact_states(0)
+        .iter()
+        .filter(|s| {
+            s.status == tribo::contact::ContactStatus::Slip && s.theta > 0.0 && s.theta < 1.0
+        })
+        .count();
+    assert!(
+        evolving > 0,
+        "some slipping node has 0 < theta < 1, so that d mu / d work is exercised"
+    );
+}
+
+fn check(mut model: tribo::solver::Model) -> Simulation {
     model.settings.increments = 12;
     let mut sim = Simulation::new(model).unwrap();
     for _ in 0..7 {
@@ -63,4 +91,5 @@ fn assembled_jacobian_matches_finite_differences() {
         worst < 1e-6 * scale,
         "assembled Jacobian differs from finite differences by {worst:e}"
     );
+    sim
 }
