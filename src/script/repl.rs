@@ -17,6 +17,7 @@ Rhai lines are evaluated in a persistent scope. Useful calls on a simulation `si
   sim.tool_force(\"punch\")         total force on a tool [fx, fy, fz]
   sim.contact_nodes(\"punch\")      state of every candidate node of a tool
   sim.contact_node(\"punch\", 12)   one node's state: status, gap, lambda_n, lambda_t, work, mu
+  sim.node_history(\"punch\", 12)   that node's work, mu and status over the increments
   sim.displacement(node)          a node's displacement
   sim.write_frame()               write a VTK frame now
   sim.history()                   one map per converged increment
