@@ -160,20 +160,21 @@ fn implicit_update_converges_at_second_order() {
 
 #[test]
 fn per_area_work_gives_a_mesh_independent_friction_field() {
-    // Work per unit area: every node obeys the same ODE whatever its tributary area.
-    let cut_density = WORK_CUT / 1.0;
-    let coarse = sliding_column(
-        2,
-        10,
-        paper_law(WorkMeasure::PerArea, cut_density),
-        FrictionUpdate::Explicit,
-    );
-    let fine = sliding_column(
-        4,
-        10,
-        paper_law(WorkMeasure::PerArea, cut_density),
-        FrictionUpdate::Explicit,
-    );
+    // Work per unit area (cut-off 50 N/mm over a 2 x 2 mm face): every node obeys the same
+    // ODE whatever its tributary area.
+    // Both meshes, 2x2 and 4x4 cells, 10 slide increments, explicit update.
+    let pair = |measure| {
+        let run = |cells| {
+            sliding_column(
+                cells,
+                10,
+                paper_law(measure, WORK_CUT),
+                FrictionUpdate::Explicit,
+            )
+        };
+        (run(2), run(4))
+    };
+    let (coarse, fine) = pair(WorkMeasure::PerArea);
     let mus: Vec<f64> = coarse
         .contact_states(0)
         .iter()
@@ -192,18 +193,7 @@ fn per_area_work_gives_a_mesh_independent_friction_field() {
     assert!(lo < 0.15, "friction has evolved (mu = {lo})");
 
     // Nodal work (the paper's): the field depends on each node's area, hence on the mesh.
-    let coarse = sliding_column(
-        2,
-        10,
-        paper_law(WorkMeasure::PerNode, WORK_CUT),
-        FrictionUpdate::Explicit,
-    );
-    let fine = sliding_column(
-        4,
-        10,
-        paper_law(WorkMeasure::PerNode, WORK_CUT),
-        FrictionUpdate::Explicit,
-    );
+    let (coarse, fine) = pair(WorkMeasure::PerNode);
     let corner = |sim: &Simulation| sim.contact_states(0)[0].mu;
     let centre = |sim: &Simulation| {
         let k = sim.model.contacts[0]
