@@ -201,6 +201,12 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
             "force_abs_tolerance" => s.force_abs_tol = num("force_abs_tolerance")?,
             "contact_tolerance" => s.contact_tol = num("contact_tolerance")?,
             "output_every" => *st = num("output_every")? as usize,
+            "eliminate_multipliers" => {
+                s.eliminate_multipliers = v
+                    .as_bool()
+                    .map_err(|t| format!("eliminate_multipliers must be true or false, got {t}"))
+                    .or_else(runtime_error)?
+            }
             "friction_update" => {
                 s.contact.friction_update = match v.clone().into_string().unwrap_or_default().as_str() {
                     "explicit" => crate::contact::FrictionUpdate::Explicit,
@@ -231,7 +237,7 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, curvature, frame, enforcement, friction_update)"
+                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, curvature, frame, enforcement, friction_update, eliminate_multipliers)"
                 ))
             }
         }

@@ -1,6 +1,7 @@
 //! Sparse assembly, linear solves, Newton iteration and incremental stepping.
 
 pub mod assembly;
+pub mod condense;
 pub mod linear;
 pub mod model;
 pub mod simulation;

@@ -61,6 +61,9 @@ pub struct SolverSettings {
     /// How many times an increment may be halved after a failed Newton solve.
     pub max_cutbacks: usize,
     pub contact: ContactSettings,
+    /// Eliminate the multipliers of single-pair, unconstrained contact nodes before the
+    /// linear solve (same Newton iterates, smaller factorization; see `condense`).
+    pub eliminate_multipliers: bool,
 }
 
 impl Default for SolverSettings {
@@ -74,6 +77,7 @@ impl Default for SolverSettings {
             increments: 10,
             max_cutbacks: 4,
             contact: ContactSettings::default(),
+            eliminate_multipliers: true,
         }
     }
 }

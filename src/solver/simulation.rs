@@ -4,6 +4,7 @@
 //! leaves the last converged state untouched.
 
 use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use super::condense::Condenser;
 use super::linear::{FaerLu, LinearSolver};
 use super::model::Model;
 use super::sparse::SparsePattern;
@@ -53,6 +54,7 @@ pub struct Simulation {
     pattern: Arc<SparsePattern>,
     is_fixed: Vec<bool>,
     linear: FaerLu,
+    condenser: Option<Condenser>,
     /// Committed unknowns [u, lambda].
     x: Vec<f64>,
     points: Vec<PointState>,
@@ -126,7 +128,13 @@ impl Simulation {
             }
             f
         };
+        let condenser = if model.settings.eliminate_multipliers {
+            Condenser::new(&model, &dofs, &pattern, &is_fixed)
+        } else {
+            None
+        };
         Ok(Simulation {
+            condenser,
             x: vec![0.0; dofs.n_dofs],
             dofs,
             pattern,
@@ -230,6 +238,23 @@ impl Simulation {
             frozen,
             is_fixed: &self.is_fixed,
         }
+    }
+
+    /// Solves J dx = -R, through the condensed system when multipliers are eliminated.
+    pub fn newton_step(&self, eval: &Evaluation, linear: &mut FaerLu) -> Result<Vec<f64>> {
+        match &self.condenser {
+            Some(c) => c.solve(&eval.jacobian, &eval.residual, linear),
+            None => {
+                let mut rhs: Vec<f64> = eval.residual.iter().map(|v| -v).collect();
+                linear.solve(&eval.jacobian, &mut rhs)?;
+                Ok(rhs)
+            }
+        }
+    }
+
+    /// Multiplier unknowns eliminated before each linear solve.
+    pub fn eliminated_multipliers(&self) -> usize {
+        self.condenser.as_ref().map_or(0, |c| c.eliminated_count())
     }
 
     /// How many symbolic LU analyses were done: one per sparsity pattern, not per iteration.
@@ -387,9 +412,8 @@ impl Simulation {
                     rec.force_rel
                 )));
             }
-            let mut rhs: Vec<f64> = eval.residual.iter().map(|v| -v).collect();
             let ts = Instant::now();
-            linear.solve(&eval.jacobian, &mut rhs)?;
+            let rhs = self.newton_step(&eval, linear)?;
             times.factorization_and_solve += ts.elapsed().as_secs_f64();
             for (xi, dx) in x.iter_mut().zip(&rhs) {
                 *xi += dx;
