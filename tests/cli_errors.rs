@@ -153,5 +153,8 @@ fn set_accepts_strings_and_booleans() {
 fn endless_loop_stops_with_a_clear_message() {
     let (code, err) = run_script("endless", "let i = 0;\nloop { i += 1; }\n", &[]);
     assert_ne!(code, 0);
-    assert!(err.contains("endless.rhai:2:") && err.to_lowercase().contains("too many operations"), "{err}");
+    assert!(
+        err.contains("endless.rhai:2:") && err.to_lowercase().contains("too many operations"),
+        "{err}"
+    );
 }
