@@ -456,6 +456,7 @@ mod tests {
             Hardening::voce(200.0, 100.0, 8.0).unwrap(),
             Hardening::linear(250.0, 1000.0).unwrap(),
             Hardening::swift(500.0, 0.01, 0.0).unwrap(),
+            Hardening::tabulated(vec![0.0, 0.2], vec![250.0, 400.0]).unwrap(),
         ] {
             let m = ElastoPlastic::new(
                 LinearElastic::new(210e3, 0.3).unwrap(),
@@ -463,6 +464,31 @@ mod tests {
                 hardening,
             );
             check_tangent(&m, Voigt::new(0.08, -0.03, -0.02, 0.04, 0.01, -0.02), true);
+        }
+    }
+
+    #[test]
+    fn one_large_step_returns_to_the_yield_surface() {
+        // 50% strain in a single increment (as after a big Newton iterate): the line
+        // search keeps the return mapping converging.
+        let m = aluminium(anisotropic());
+        for eps in [
+            Voigt::new(0.5, -0.2, -0.3, 0.1, 0.0, 0.0),
+            Voigt::new(-0.3, 0.4, -0.1, -0.2, 0.15, 0.05),
+        ] {
+            let mut st = PointState::default();
+            m.update(
+                &Kinematics::from_strain(eps),
+                &PointState::default(),
+                &mut st,
+            )
+            .unwrap();
+            assert!(st.eq_plastic_strain > 0.1);
+            let sy = m.hardening().yield_stress(st.eq_plastic_strain);
+            assert!(m.yield_value(&st).abs() <= 1e-10 * sy);
+            // Plastic work rate is positive: σ·Δεp = Δλ φ > 0.
+            let work = st.stress.dot(&st.plastic_strain);
+            assert!((work - st.eq_plastic_strain * sy).abs() <= 1e-8 * work.abs());
         }
     }
 
