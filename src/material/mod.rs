@@ -31,8 +31,14 @@ use nalgebra::{Matrix6, Vector6};
 use crate::geometry::Mat3;
 use crate::Result;
 
+mod elastoplastic;
+mod hardening;
+mod hill48;
 mod linear_elastic;
 
+pub use elastoplastic::ElastoPlastic;
+pub use hardening::Hardening;
+pub use hill48::Hill48;
 pub use linear_elastic::LinearElastic;
 
 /// A symmetric tensor in Voigt notation `[xx, yy, zz, xy, yz, zx]`; see the module

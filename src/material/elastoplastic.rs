@@ -1,0 +1,530 @@
+//! Small-strain elastoplasticity: isotropic linear elasticity, Hill48 (or von Mises)
+//! yield, associative flow, isotropic hardening, closest-point return mapping and the
+//! consistent tangent.
+//!
+//! # Equations (Voigt; strains with engineering shear, stresses with tensor shear)
+//!
+//! Additive split `ε = εe + εp`, `σ = D εe = D (ε - εp)`. With the committed plastic
+//! strain `εp_n` and equivalent plastic strain `ε̄p_n`, the elastic trial stress is
+//! `σ_tr = D (ε - εp_n)`. If `φ(σ_tr) <= σ_y(ε̄p_n)` the step is elastic. Otherwise the
+//! backward-Euler (closest-point) return solves, for `σ` and the multiplier `Δλ >= 0`,
+//!
+//! ```text
+//! r = S σ - S σ_tr + Δλ n(σ) = 0        (S = D⁻¹, n = ∂φ/∂σ = Pσ/φ)
+//! f = φ(σ) - σ_y(ε̄p_n + Δλ)   = 0
+//! ```
+//!
+//! by Newton on the full 7x7 system (the flow direction of Hill48 changes along the
+//! return, so there is no scalar radial return as for von Mises), with the Jacobian
+//!
+//! ```text
+//! | S + Δλ ∂n/∂σ   n  |      ∂n/∂σ = (P - n nᵀ)/φ,   h = σ_y'(ε̄p_n + Δλ),
+//! | nᵀ            -h  |
+//! ```
+//!
+//! and a backtracking line search on the residual norm for large steps. Then
+//! `εp = ε - Sσ`, `ε̄p = ε̄p_n + Δλ` (`σ·ε̇p = λ̇ φ`: `Δλ` is work-conjugate to `φ`).
+//!
+//! # Consistent tangent
+//!
+//! Linearising the converged equations in `ε` (`S dσ_tr = dε`) gives, with
+//! `Ξ = (S + Δλ ∂n/∂σ)⁻¹`,
+//!
+//! ```text
+//! D_alg = Ξ - (Ξ n)(Ξ n)ᵀ / (nᵀ Ξ n + h),
+//! ```
+//!
+//! symmetric because the flow is associative. It is what makes the global Newton
+//! iteration converge quadratically.
+
+use nalgebra::{SMatrix, SVector};
+
+use super::{Hardening, Hill48, Kinematics, LinearElastic, Material, PointState, Tangent, Voigt};
+use crate::{Error, Result};
+
+/// Relative yield tolerance: a trial stress within this fraction of the yield stress is
+/// elastic (avoids a return mapping of zero length from round-off on the yield surface).
+const YIELD_TOL: f64 = 1e-12;
+/// Relative tolerance of the return-mapping residual (in stress units, relative to the
+/// larger of the yield stress and the trial equivalent stress).
+const RETURN_TOL: f64 = 1e-12;
+/// Iteration limit of the return mapping.
+const MAX_ITER: usize = 60;
+
+/// Small-strain elastoplastic material: [`LinearElastic`] elasticity, [`Hill48`] yield
+/// (von Mises with [`Hill48::von_mises`]), [`Hardening`] isotropic hardening of the yield
+/// stress in the equivalent plastic strain. See the module documentation for the math.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ElastoPlastic {
+    elastic: LinearElastic,
+    yield_function: Hill48,
+    hardening: Hardening,
+}
+
+/// Result of a return mapping: stress, multiplier increment and consistent tangent.
+struct Return {
+    stress: Voigt,
+    dlambda: f64,
+    tangent: Tangent,
+}
+
+impl ElastoPlastic {
+    /// Combines validated components (each constructor already checks its parameters).
+    pub fn new(elastic: LinearElastic, yield_function: Hill48, hardening: Hardening) -> Self {
+        ElastoPlastic {
+            elastic,
+            yield_function,
+            hardening,
+        }
+    }
+
+    /// The elastic part.
+    pub fn elastic(&self) -> &LinearElastic {
+        &self.elastic
+    }
+
+    /// The yield function.
+    pub fn yield_function(&self) -> &Hill48 {
+        &self.yield_function
+    }
+
+    /// The hardening law.
+    pub fn hardening(&self) -> &Hardening {
+        &self.hardening
+    }
+
+    /// Yield function value `f = φ(σ) - σ_y(ε̄p)` of a state (`<= 0` inside the surface).
+    pub fn yield_value(&self, state: &PointState) -> f64 {
+        self.yield_function.equivalent_stress(&state.stress)
+            - self.hardening.yield_stress(state.eq_plastic_strain)
+    }
+
+    /// Closest-point return of the trial stress `sig_tr` from `ε̄p_n = ebar_n`.
+    fn return_map(&self, sig_tr: &Voigt, ebar_n: f64) -> Result<Return> {
+        let p = self.yield_function.matrix();
+        let s = self.elastic.compliance();
+        // Scale the strain-like residual rows by E so that all 7 residuals are stresses.
+        let e = self.elastic.young();
+        let eps_tr = s * sig_tr;
+        let phi_tr = self.yield_function.equivalent_stress(sig_tr);
+        let tol = RETURN_TOL * phi_tr.max(self.hardening.yield_stress(ebar_n));
+
+        let residual = |sig: &Voigt, dl: f64| -> Option<SVector<f64, 7>> {
+            let phi = self.yield_function.equivalent_stress(sig);
+            if !(phi > 0.0) || !phi.is_finite() {
+                return None;
+            }
+            let n = p * sig / phi;
+            let r = (s * sig - eps_tr + n * dl) * e;
+            let f = phi - self.hardening.yield_stress(ebar_n + dl);
+            Some(SVector::<f64, 7>::from_iterator(
+                r.iter().copied().chain(std::iter::once(f)),
+            ))
+        };
+
+        let (mut sig, mut dl) = (*sig_tr, 0.0);
+        let mut res = residual(&sig, dl).ok_or_else(|| self.failure(sig_tr, "zero trial"))?;
+        for _ in 0..MAX_ITER {
+            if res.amax() <= tol {
+                return Ok(self.converged(sig, dl, ebar_n));
+            }
+            let phi = self.yield_function.equivalent_stress(&sig);
+            let n = p * sig / phi;
+            let h = self.hardening.slope(ebar_n + dl);
+            let a = s + (p - n * n.transpose()) * (dl / phi);
+            let mut jac = SMatrix::<f64, 7, 7>::zeros();
+            jac.fixed_view_mut::<6, 6>(0, 0).copy_from(&(a * e));
+            jac.fixed_view_mut::<6, 1>(0, 6).copy_from(&(n * e));
+            jac.fixed_view_mut::<1, 6>(6, 0).copy_from(&n.transpose());
+            jac[(6, 6)] = -h;
+            let step = jac
+                .lu()
+                .solve(&(-res))
+                .ok_or_else(|| self.failure(sig_tr, "singular return-mapping Jacobian"))?;
+            // Backtracking: accept the first step length that reduces the residual norm.
+            let norm = res.norm();
+            let mut alpha = 1.0;
+            loop {
+                let trial_sig = sig + step.fixed_rows::<6>(0) * alpha;
+                // Δλ >= 0 keeps the hardening law in its domain (ε̄p >= ε̄p_n).
+                let trial_dl = (dl + step[6] * alpha).max(0.0);
+                if let Some(r) = residual(&trial_sig, trial_dl) {
+                    if r.norm() < norm || alpha < 1e-6 {
+                        sig = trial_sig;
+                        dl = trial_dl;
+                        res = r;
+                        break;
+                    }
+                }
+                alpha *= 0.5;
+                if alpha < 1e-10 {
+                    return Err(self.failure(sig_tr, "line search failed"));
+                }
+            }
+        }
+        if res.amax() <= tol {
+            return Ok(self.converged(sig, dl, ebar_n));
+        }
+        Err(self.failure(
+            sig_tr,
+            &format!(
+                "no convergence in {MAX_ITER} iterations, residual {:e}",
+                res.amax()
+            ),
+        ))
+    }
+
+    /// Consistent tangent at the converged return (see the module docs).
+    fn converged(&self, sig: Voigt, dl: f64, ebar_n: f64) -> Return {
+        let p = self.yield_function.matrix();
+        let phi = self.yield_function.equivalent_stress(&sig);
+        let n = p * sig / phi;
+        let h = self.hardening.slope(ebar_n + dl);
+        let a = self.elastic.compliance() + (p - n * n.transpose()) * (dl / phi);
+        // `a` is symmetric positive definite (S SPD, P - nnᵀ PSD by Cauchy-Schwarz in the
+        // P inner product), so Cholesky cannot fail for admissible parameters.
+        let xi = match a.cholesky() {
+            Some(c) => c.inverse(),
+            None => a.try_inverse().unwrap_or_else(|| self.elastic.tangent()),
+        };
+        let xn = xi * n;
+        let mut tangent = xi - xn * xn.transpose() / (n.dot(&xn) + h);
+        tangent = (tangent + tangent.transpose()) * 0.5;
+        Return {
+            stress: sig,
+            dlambda: dl,
+            tangent,
+        }
+    }
+
+    fn failure(&self, sig_tr: &Voigt, why: &str) -> Error {
+        Error::NoConvergence(format!(
+            "return mapping ({}, {}): {why}; trial stress {:?}",
+            self.yield_function.describe(),
+            self.hardening.describe(),
+            sig_tr.as_slice()
+        ))
+    }
+}
+
+impl Material for ElastoPlastic {
+    fn update(
+        &self,
+        kin: &Kinematics,
+        committed: &PointState,
+        trial: &mut PointState,
+    ) -> Result<Tangent> {
+        if !kin.strain.iter().all(|v| v.is_finite()) {
+            // A diverging Newton iterate, not bad user input: the solver cuts back.
+            return Err(Error::NoConvergence(format!(
+                "non-finite strain {:?} at an integration point",
+                kin.strain.as_slice()
+            )));
+        }
+        let ebar_n = committed.eq_plastic_strain;
+        let sig_tr = self
+            .elastic
+            .stress(&(kin.strain - committed.plastic_strain));
+        let base = PointState {
+            strain: kin.strain,
+            deformation_gradient: kin.deformation_gradient,
+            ..*committed
+        };
+        let sy = self.hardening.yield_stress(ebar_n);
+        if self.yield_function.equivalent_stress(&sig_tr) - sy <= YIELD_TOL * sy {
+            *trial = PointState {
+                stress: sig_tr,
+                ..base
+            };
+            return Ok(self.elastic.tangent());
+        }
+        let ret = self.return_map(&sig_tr, ebar_n)?;
+        *trial = PointState {
+            stress: ret.stress,
+            // ε - Sσ rather than εp_n + Δλ n: exactly consistent with σ = D(ε - εp).
+            plastic_strain: kin.strain - self.elastic.compliance() * ret.stress,
+            eq_plastic_strain: ebar_n + ret.dlambda,
+            ..base
+        };
+        Ok(ret.tangent)
+    }
+
+    fn elastic_tangent(&self) -> Tangent {
+        self.elastic.tangent()
+    }
+
+    /// `½ εe·D εe = ½ σ·Sσ` with the elastic strain `εe = ε - εp`.
+    fn elastic_energy_density(&self, state: &PointState) -> f64 {
+        self.elastic.energy_density_of_stress(&state.stress)
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "elastoplastic E={} nu={}, {}, {}",
+            self.elastic.young(),
+            self.elastic.poisson(),
+            self.yield_function.describe(),
+            self.hardening.describe()
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn swift() -> Hardening {
+        Hardening::swift(500.0, 0.01, 0.22).unwrap()
+    }
+
+    fn aluminium(yield_function: Hill48) -> ElastoPlastic {
+        ElastoPlastic::new(
+            LinearElastic::new(70e3, 0.33).unwrap(),
+            yield_function,
+            swift(),
+        )
+    }
+
+    fn anisotropic() -> Hill48 {
+        Hill48::from_lankford(0.7, 1.3, 2.1).unwrap()
+    }
+
+    /// Direction vector `q = [c², s², 0, cs, 0, 0]` of uniaxial loading at `angle` to x:
+    /// `q·ε` is the normal strain along the direction (engineering shear) and `s q` the
+    /// uniaxial stress `s a⊗a` (tensor shear), so one vector serves both.
+    fn direction(angle: f64) -> Voigt {
+        let (s, c) = angle.sin_cos();
+        Voigt::new(c * c, s * s, 0.0, c * s, 0.0, 0.0)
+    }
+
+    /// Uniaxial stress along `angle` to x, driven by the strain `q·ε` in `steps` equal
+    /// increments up to `eps_max`: at each step Newton with the material's consistent
+    /// tangent solves the mixed problem `σ(ε) = s q`, `q·ε = target` for `(ε, s)`, all
+    /// other stress components zero (plane stress `σzz = 0` included). Returns the
+    /// committed state after every step.
+    fn uniaxial(m: &ElastoPlastic, angle: f64, eps_max: f64, steps: usize) -> Vec<PointState> {
+        let q = direction(angle);
+        let mut committed = m.initial_state();
+        let mut states = Vec::new();
+        for k in 1..=steps {
+            let target = eps_max * k as f64 / steps as f64;
+            let mut eps = committed.strain;
+            let mut s = q.dot(&committed.stress);
+            let mut trial = committed;
+            let mut converged = false;
+            for _ in 0..40 {
+                let d = m
+                    .update(&Kinematics::from_strain(eps), &committed, &mut trial)
+                    .unwrap();
+                let r_sig = trial.stress - q * s;
+                let r_eps = q.dot(&eps) - target;
+                if r_sig.amax() <= 1e-10 * s.abs().max(1.0) && r_eps.abs() < 1e-15 {
+                    converged = true;
+                    break;
+                }
+                let mut jac = SMatrix::<f64, 7, 7>::zeros();
+                jac.fixed_view_mut::<6, 6>(0, 0).copy_from(&d);
+                jac.fixed_view_mut::<6, 1>(0, 6).copy_from(&(-q));
+                jac.fixed_view_mut::<1, 6>(6, 0).copy_from(&q.transpose());
+                let rhs = -SVector::<f64, 7>::from_iterator(
+                    r_sig.iter().copied().chain(std::iter::once(r_eps)),
+                );
+                let dx = jac.lu().solve(&rhs).unwrap();
+                eps += dx.fixed_rows::<6>(0);
+                s += dx[6];
+            }
+            assert!(converged, "uniaxial driver, step {k}");
+            committed = trial;
+            states.push(committed);
+        }
+        states
+    }
+
+    #[test]
+    fn uniaxial_tension_reproduces_the_swift_curve() {
+        for yf in [Hill48::von_mises(), anisotropic()] {
+            let m = aluminium(yf);
+            let states = uniaxial(&m, 0.0, 0.5, 100);
+            let mut plastic_steps = 0;
+            for st in &states {
+                let sig = st.stress[0];
+                let ep = st.plastic_strain[0];
+                if ep <= 0.0 {
+                    continue;
+                }
+                plastic_steps += 1;
+                let expect = 500.0 * (0.01 + ep).powf(0.22);
+                assert!(
+                    (sig - expect).abs() <= 1e-6 * expect,
+                    "{sig} vs {expect} at {ep}"
+                );
+                // Along the rolling direction the equivalent plastic strain is εp_xx.
+                assert!((st.eq_plastic_strain - ep).abs() <= 1e-9);
+                // Uniaxial: every other stress component vanishes.
+                let others = st.stress.iter().skip(1).fold(0.0f64, |a, v| a.max(v.abs()));
+                assert!(others <= 1e-8 * sig);
+            }
+            assert!(plastic_steps >= 99, "{plastic_steps}");
+            let last = states.last().unwrap();
+            assert!((last.strain[0] - 0.5).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn tension_at_0_45_90_degrees_gives_back_the_lankford_coefficients() {
+        let (r0, r45, r90) = (0.7, 1.3, 2.1);
+        let m = aluminium(Hill48::from_lankford(r0, r45, r90).unwrap());
+        for (deg, r_expect) in [(0.0, r0), (45.0, r45), (90.0, r90)] {
+            let angle = f64::to_radians(deg);
+            let states = uniaxial(&m, angle, 0.1, 20);
+            let (a, b) = (&states[states.len() - 2], &states[states.len() - 1]);
+            let dep = b.plastic_strain - a.plastic_strain;
+            // Width direction w = (-sin, cos, 0): ε_ww = s²εxx + c²εyy - cs γxy.
+            let (s, c) = angle.sin_cos();
+            let width = s * s * dep[0] + c * c * dep[1] - c * s * dep[3];
+            let r = width / dep[2];
+            assert!((r - r_expect).abs() <= 0.01 * r_expect, "{deg}°: r = {r}");
+            // Exact for Hill48 (the flow direction is constant under uniaxial stress).
+            assert!((r - r_expect).abs() <= 1e-6 * r_expect, "{deg}°: r = {r}");
+            assert!(b.stress[2].abs() < 1e-6, "plane stress");
+        }
+    }
+
+    /// Committed state with plastic history, then the tangent at `eps` from it against
+    /// central differences of the stress update.
+    fn check_tangent(m: &ElastoPlastic, eps: Voigt, expect_plastic: bool) {
+        let history = Voigt::new(0.01, -0.004, -0.003, 0.006, -0.002, 0.003);
+        let mut committed = m.initial_state();
+        m.update(
+            &Kinematics::from_strain(history),
+            &PointState::default(),
+            &mut committed,
+        )
+        .unwrap();
+        assert!(committed.eq_plastic_strain > 0.0);
+        let mut trial = committed;
+        let d = m
+            .update(&Kinematics::from_strain(eps), &committed, &mut trial)
+            .unwrap();
+        assert_eq!(
+            trial.eq_plastic_strain > committed.eq_plastic_strain,
+            expect_plastic
+        );
+        let h = 1e-6;
+        let mut fd = Tangent::zeros();
+        for j in 0..6 {
+            let mut ep = eps;
+            let mut em = eps;
+            ep[j] += h;
+            em[j] -= h;
+            let (mut sp, mut sm) = (committed, committed);
+            m.update(&Kinematics::from_strain(ep), &committed, &mut sp)
+                .unwrap();
+            m.update(&Kinematics::from_strain(em), &committed, &mut sm)
+                .unwrap();
+            fd.set_column(j, &((sp.stress - sm.stress) / (2.0 * h)));
+        }
+        let err = (d - fd).amax() / d.amax();
+        assert!(err < 1e-6, "{}: relative error {err:e}", m.describe());
+        if expect_plastic {
+            // The plastic tangent is softer than the elastic one.
+            assert!((d - m.elastic_tangent()).amax() > 1e-3 * d.amax());
+        } else {
+            assert_eq!(d, m.elastic_tangent());
+        }
+    }
+
+    #[test]
+    fn consistent_tangent_equals_central_differences() {
+        for yf in [Hill48::von_mises(), anisotropic()] {
+            let m = aluminium(yf);
+            // Plastic: continued loading in another direction.
+            check_tangent(
+                &m,
+                Voigt::new(0.014, -0.002, -0.006, 0.01, 0.001, 0.004),
+                true,
+            );
+            // Elastic: unloading a little from the committed strain.
+            check_tangent(
+                &m,
+                Voigt::new(0.0099, -0.004, -0.003, 0.006, -0.002, 0.003),
+                false,
+            );
+        }
+        // Other hardening laws, one large step far beyond yield.
+        for hardening in [
+            Hardening::voce(200.0, 100.0, 8.0).unwrap(),
+            Hardening::linear(250.0, 1000.0).unwrap(),
+            Hardening::swift(500.0, 0.01, 0.0).unwrap(),
+            Hardening::tabulated(vec![0.0, 0.2], vec![250.0, 400.0]).unwrap(),
+        ] {
+            let m = ElastoPlastic::new(
+                LinearElastic::new(210e3, 0.3).unwrap(),
+                anisotropic(),
+                hardening,
+            );
+            check_tangent(&m, Voigt::new(0.08, -0.03, -0.02, 0.04, 0.01, -0.02), true);
+        }
+    }
+
+    #[test]
+    fn one_large_step_returns_to_the_yield_surface() {
+        // 50% strain in a single increment (as after a big Newton iterate): the line
+        // search keeps the return mapping converging.
+        let m = aluminium(anisotropic());
+        for eps in [
+            Voigt::new(0.5, -0.2, -0.3, 0.1, 0.0, 0.0),
+            Voigt::new(-0.3, 0.4, -0.1, -0.2, 0.15, 0.05),
+        ] {
+            let mut st = PointState::default();
+            m.update(
+                &Kinematics::from_strain(eps),
+                &PointState::default(),
+                &mut st,
+            )
+            .unwrap();
+            assert!(st.eq_plastic_strain > 0.1);
+            let sy = m.hardening().yield_stress(st.eq_plastic_strain);
+            assert!(m.yield_value(&st).abs() <= 1e-10 * sy);
+            // Plastic work rate is positive: σ·Δεp = Δλ φ > 0.
+            let work = st.stress.dot(&st.plastic_strain);
+            assert!((work - st.eq_plastic_strain * sy).abs() <= 1e-8 * work.abs());
+        }
+    }
+
+    #[test]
+    fn von_mises_return_is_radial_and_energy_uses_the_elastic_strain() {
+        let m = ElastoPlastic::new(
+            LinearElastic::new(200e3, 0.3).unwrap(),
+            Hill48::von_mises(),
+            Hardening::linear(300.0, 2000.0).unwrap(),
+        );
+        let eps = Voigt::new(0.01, 0.002, -0.004, 0.003, 0.0, 0.001);
+        let mut st = PointState::default();
+        m.update(
+            &Kinematics::from_strain(eps),
+            &PointState::default(),
+            &mut st,
+        )
+        .unwrap();
+        // Radial return in closed form: Δλ = (q_tr - σy) / (3μ + H).
+        let el = m.elastic();
+        let sig_tr = el.stress(&eps);
+        let q_tr = super::super::von_mises(&sig_tr);
+        let dl = (q_tr - 300.0) / (3.0 * el.shear_modulus() + 2000.0);
+        assert!((st.eq_plastic_strain - dl).abs() < 1e-12);
+        assert!(m.yield_value(&st).abs() < 1e-8);
+        // Same pressure as the trial (plastic flow is isochoric).
+        let tr = |v: &Voigt| v[0] + v[1] + v[2];
+        assert!((tr(&st.stress) - tr(&sig_tr)).abs() < 1e-8);
+        assert!(tr(&st.plastic_strain).abs() < 1e-14);
+        let ee = st.strain - st.plastic_strain;
+        assert!((m.elastic_energy_density(&st) - el.energy_density(&ee)).abs() < 1e-10);
+        let bad = Kinematics::from_strain(Voigt::new(f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0));
+        assert!(matches!(
+            m.update(&bad, &PointState::default(), &mut st),
+            Err(Error::NoConvergence(_))
+        ));
+        assert!(m.describe().contains("Hill48 F=0.5"));
+    }
+}
