@@ -208,12 +208,14 @@ pub fn frame(sim: &Simulation) -> Frame {
     let per = sim.points().len() / mesh.hexes.len().max(1);
     let mut stress = vec![0.0; 6 * mesh.hexes.len()];
     let mut von_mises = vec![0.0; mesh.hexes.len()];
+    let mut eq_plastic = vec![0.0; mesh.hexes.len()];
     for e in 0..mesh.hexes.len() {
         let pts = &sim.points()[e * per..(e + 1) * per];
         for p in pts {
             for i in 0..6 {
                 stress[6 * e + i] += p.stress[i] / per as f64;
             }
+            eq_plastic[e] += p.eq_plastic_strain / per as f64;
         }
         let s = &stress[6 * e..6 * e + 6];
         von_mises[e] = (0.5

@@ -4,7 +4,7 @@
 use super::convert::*;
 use crate::contact::{BernsteinLaw, FrictionLaw, WorkMeasure};
 use crate::geometry::{Cylinder, Plane, RigidSurface, Sphere};
-use crate::material::{LinearElastic, Material};
+use crate::material::{ElastoPlastic, Hardening, Hill48, LinearElastic, Material};
 use crate::mesh::{End, Grading, Mesh};
 use crate::tool::schedule::{ScalarSchedule, Schedule};
 use crate::tool::Tool;
@@ -210,6 +210,82 @@ fn register_material(engine: &mut Engine) {
         },
     );
     engine.register_fn("to_string", |m: &mut ScriptMaterial| format!("{:?}", m.0));
+
+    // Small-strain elastoplasticity: elastoplastic(E, nu, yield, hardening).
+    engine.register_type_with_name::<Hardening>("Hardening");
+    engine.register_type_with_name::<Hill48>("YieldFunction");
+    engine.register_fn(
+        "swift",
+        |c: Dynamic, eps0: Dynamic, n: Dynamic| -> ScriptResult<Hardening> {
+            lift(Hardening::swift(
+                number(&c, "Swift C")?,
+                number(&eps0, "Swift eps0")?,
+                number(&n, "Swift n")?,
+            ))
+        },
+    );
+    engine.register_fn(
+        "voce",
+        |s0: Dynamic, q: Dynamic, b: Dynamic| -> ScriptResult<Hardening> {
+            lift(Hardening::voce(
+                number(&s0, "Voce s0")?,
+                number(&q, "Voce Q")?,
+                number(&b, "Voce b")?,
+            ))
+        },
+    );
+    engine.register_fn(
+        "linear_hardening",
+        |s0: Dynamic, h: Dynamic| -> ScriptResult<Hardening> {
+            lift(Hardening::linear(
+                number(&s0, "initial yield stress")?,
+                number(&h, "hardening modulus")?,
+            ))
+        },
+    );
+    engine.register_fn(
+        "hardening_table",
+        |strain: Array, stress: Array| -> ScriptResult<Hardening> {
+            let e = strain
+                .iter()
+                .map(|v| number(v, "table strain"))
+                .collect::<ScriptResult<Vec<f64>>>()?;
+            let s = stress
+                .iter()
+                .map(|v| number(v, "table stress"))
+                .collect::<ScriptResult<Vec<f64>>>()?;
+            lift(Hardening::tabulated(e, s))
+        },
+    );
+    engine.register_fn("von_mises", Hill48::von_mises);
+    engine.register_fn(
+        "hill48",
+        |r0: Dynamic, r45: Dynamic, r90: Dynamic| -> ScriptResult<Hill48> {
+            lift(Hill48::from_lankford(
+                number(&r0, "r0")?,
+                number(&r45, "r45")?,
+                number(&r90, "r90")?,
+            ))
+        },
+    );
+    engine.register_fn(
+        "elastoplastic",
+        |e: Dynamic,
+         nu: Dynamic,
+         yield_function: Hill48,
+         hardening: Hardening|
+         -> ScriptResult<ScriptMaterial> {
+            let elastic = lift(LinearElastic::new(
+                number(&e, "Young's modulus")?,
+                number(&nu, "Poisson's ratio")?,
+            ))?;
+            Ok(ScriptMaterial(Arc::new(ElastoPlastic::new(
+                elastic,
+                yield_function,
+                hardening,
+            ))))
+        },
+    );
 }
 
 fn schedule_points(table: &Array, columns: usize) -> ScriptResult<Vec<Vec<f64>>> {
