@@ -157,7 +157,7 @@ impl BezierPatch {
                 e.su.cross(&e.sv).norm()
             })
             .fold(0.0, f64::max);
-        if !(max_area > 1e-12 * size * size) {
+        if max_area.is_nan() || max_area <= 1e-12 * size * size {
             return Err(Error::input(
                 "bezier patch area element max |S_u x S_v|",
                 max_area,
@@ -252,7 +252,7 @@ impl BezierPatch {
     pub fn normal(&self, e: &PatchPoint) -> Option<Vec3> {
         let c = e.su.cross(&e.sv);
         let len = c.norm();
-        if !(len > 1e-14 * e.su.norm() * e.sv.norm()) || len == 0.0 {
+        if len.is_nan() || len == 0.0 || len <= 1e-14 * e.su.norm() * e.sv.norm() {
             return None;
         }
         Some(if self.flip { -c / len } else { c / len })
@@ -348,7 +348,8 @@ fn frame(what: &str, axis: &Vec3, reference: &Vec3, angle: f64) -> Result<(Vec3,
     let a = unit_vec3(&format!("{what} axis"), axis)?;
     let r = finite_vec3(&format!("{what} reference direction"), reference)?;
     let across = r - a * a.dot(&r);
-    if !(across.norm() > 1e-12 * r.norm()) {
+    let across_len = across.norm();
+    if across_len.is_nan() || across_len <= 1e-12 * r.norm() {
         return Err(Error::input(
             &format!("{what} reference direction"),
             fmt_vec3(&r),

@@ -118,14 +118,14 @@ impl PatchSurface {
             Some((u, v)) => (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0)),
             None => {
                 let n = COLD_SAMPLES as f64;
-                (0..=COLD_SAMPLES)
+                let (_, u, v) = (0..=COLD_SAMPLES)
                     .flat_map(|i| (0..=COLD_SAMPLES).map(move |j| (i as f64 / n, j as f64 / n)))
                     .map(|(u, v)| (dist2(u, v), u, v))
                     .fold(
                         (f64::INFINITY, 0.5, 0.5),
                         |b, c| if c.0 < b.0 { c } else { b },
-                    )
-                    .pipe(|(_, u, v)| (u, v))
+                    );
+                (u, v)
             }
         };
         let mut e = patch.evaluate(u, v);
@@ -214,7 +214,8 @@ impl PatchSurface {
         };
         if loc.kind == Kind::Interior || on_surface || surface_normal.is_none() {
             let Some(n) = surface_normal else {
-                // Degenerate foot (a collapsed edge): only the direction to x is defined.
+                // Degenerate foot (a collapsed edge): only the direction to x is defined; it is
+                // treated like a corner (an approximation: the foot may still slide).
                 return if on_surface {
                     None
                 } else {
@@ -252,7 +253,7 @@ impl PatchSurface {
                     (e.su, e.suu)
                 };
                 let stiffness = c1.dot(&c1) - c2.dot(&r);
-                if !(stiffness > 0.0) {
+                if stiffness.is_nan() || stiffness <= 0.0 {
                     return None;
                 }
                 point_like(n, gap, c1 * c1.transpose() / stiffness)
@@ -309,14 +310,6 @@ fn newton_step(e: &PatchPoint, r: &Vec3, g: [f64; 2], fixed: [bool; 2]) -> [f64;
         }
     }
 }
-
-/// `value.pipe(f)` = `f(value)`, to keep the cold-start chain readable.
-trait Pipe: Sized {
-    fn pipe<T>(self, f: impl FnOnce(Self) -> T) -> T {
-        f(self)
-    }
-}
-impl<T> Pipe for T {}
 
 impl RigidSurface for PatchSurface {
     /// Closest point over all patches. The hinted patch is tried first from the hinted
