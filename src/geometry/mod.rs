@@ -7,8 +7,10 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+pub mod bezier;
 mod check;
 pub mod cylinder;
+pub mod patch_surface;
 pub mod plane;
 pub mod sphere;
 #[cfg(test)]
@@ -16,7 +18,9 @@ pub(crate) mod testutil;
 
 pub(crate) use check::{finite_vec3, fmt_vec3, positive_length, unit_vec3};
 
+pub use bezier::{BezierPatch, PatchPoint};
 pub use cylinder::Cylinder;
+pub use patch_surface::PatchSurface;
 pub use plane::Plane;
 pub use sphere::Sphere;
 

@@ -1,0 +1,552 @@
+//! Rational tensor-product Bézier patches: point, first and second derivatives, normal.
+//!
+//! A patch of degree `(p, q)` with control points `P_ij` and weights `w_ij > 0` is
+//!
+//! ```text
+//! S(u, v) = A(u, v) / W(u, v),   A = sum_ij w_ij P_ij B_i^p(u) B_j^q(v),
+//!                                W = sum_ij w_ij      B_i^p(u) B_j^q(v),
+//! ```
+//!
+//! on `(u, v)` in `[0, 1]^2`, with Bernstein polynomials `B_i^p`. Derivatives are exact:
+//! the homogeneous pair `(A, W)` is polynomial, and the quotient rule gives
+//!
+//! ```text
+//! S_u  = (A_u - W_u S) / W
+//! S_uu = (A_uu - 2 W_u S_u - W_uu S) / W
+//! S_uv = (A_uv - W_u S_v - W_v S_u - W_uv S) / W      (and symmetrically in v).
+//! ```
+//!
+//! Positive weights keep `W > 0` and the patch inside the convex hull of its control
+//! points, which the projection uses for bounding boxes.
+
+use super::*;
+use crate::{Error, Result};
+
+/// A rational Bézier patch; control points and weights row-major, `(p+1) x (q+1)`
+/// (index `i * (q + 1) + j`, `i` along `u`).
+#[derive(Debug, Clone)]
+pub struct BezierPatch {
+    degree_u: usize,
+    degree_v: usize,
+    points: Vec<Vec3>,
+    weights: Vec<f64>,
+    /// Outward normal is `-S_u x S_v` instead of `S_u x S_v`.
+    flip: bool,
+}
+
+/// Point and derivatives of a patch at one `(u, v)`.
+#[derive(Debug, Clone, Copy)]
+pub struct PatchPoint {
+    pub point: Vec3,
+    pub su: Vec3,
+    pub sv: Vec3,
+    pub suu: Vec3,
+    pub suv: Vec3,
+    pub svv: Vec3,
+}
+
+/// Bernstein values of degree `n` at `t`, and their first and second derivatives, from the
+/// lower-degree bases: `B'_i^n = n (B_{i-1}^{n-1} - B_i^{n-1})` and similarly twice.
+fn bernstein_with_derivatives(n: usize, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    // All degrees 0..=n by the triangle B_i^k = (1-t) B_i^{k-1} + t B_{i-1}^{k-1}.
+    let mut by_degree: Vec<Vec<f64>> = vec![vec![1.0]];
+    for k in 1..=n {
+        let prev = &by_degree[k - 1];
+        let row = (0..=k)
+            .map(|i| {
+                let left = if i < k { (1.0 - t) * prev[i] } else { 0.0 };
+                let right = if i > 0 { t * prev[i - 1] } else { 0.0 };
+                left + right
+            })
+            .collect();
+        by_degree.push(row);
+    }
+    let lower = |k: usize, i: isize| -> f64 {
+        if i < 0 || i as usize > k {
+            0.0
+        } else {
+            by_degree[k][i as usize]
+        }
+    };
+    let nf = n as f64;
+    let d1 = (0..=n as isize)
+        .map(|i| {
+            if n == 0 {
+                0.0
+            } else {
+                nf * (lower(n - 1, i - 1) - lower(n - 1, i))
+            }
+        })
+        .collect();
+    let d2 = (0..=n as isize)
+        .map(|i| {
+            if n < 2 {
+                0.0
+            } else {
+                nf * (nf - 1.0)
+                    * (lower(n - 2, i - 2) - 2.0 * lower(n - 2, i - 1) + lower(n - 2, i))
+            }
+        })
+        .collect();
+    (by_degree.pop().unwrap(), d1, d2)
+}
+
+impl BezierPatch {
+    /// Errs if a degree is 0, the counts differ from `(p+1)(q+1)`, a point or weight is not
+    /// finite, a weight is not > 0, or the patch is degenerate (no normal anywhere, e.g. all
+    /// control points equal).
+    pub fn new(
+        degree_u: usize,
+        degree_v: usize,
+        points: Vec<Vec3>,
+        weights: Vec<f64>,
+    ) -> Result<BezierPatch> {
+        for (what, d) in [
+            ("bezier patch degree_u", degree_u),
+            ("bezier patch degree_v", degree_v),
+        ] {
+            if d == 0 {
+                return Err(Error::input(what, d, "must be >= 1"));
+            }
+        }
+        let count = (degree_u + 1) * (degree_v + 1);
+        let requirement = format!("must be (degree_u + 1) * (degree_v + 1) = {count}");
+        if points.len() != count {
+            return Err(Error::input(
+                "bezier patch control point count",
+                points.len(),
+                &requirement,
+            ));
+        }
+        if weights.len() != count {
+            return Err(Error::input(
+                "bezier patch weight count",
+                weights.len(),
+                &requirement,
+            ));
+        }
+        for (k, p) in points.iter().enumerate() {
+            let (i, j) = (k / (degree_v + 1), k % (degree_v + 1));
+            finite_vec3(&format!("bezier patch control point [{i}][{j}]"), p)?;
+        }
+        for (k, &w) in weights.iter().enumerate() {
+            let (i, j) = (k / (degree_v + 1), k % (degree_v + 1));
+            let what = format!("bezier patch weight [{i}][{j}]");
+            if !w.is_finite() {
+                return Err(Error::input(&what, w, "must be finite"));
+            }
+            if w <= 0.0 {
+                return Err(Error::input(&what, w, "must be > 0"));
+            }
+        }
+        let patch = BezierPatch {
+            degree_u,
+            degree_v,
+            points,
+            weights,
+            flip: false,
+        };
+        // Degenerate if |S_u x S_v| vanishes on a grid of samples relative to the size:
+        // isolated degenerate points (a pole) are allowed, a patch without area is not.
+        let size = patch.extent();
+        let samples = 6;
+        let max_area = (0..=samples)
+            .flat_map(|a| (0..=samples).map(move |b| (a, b)))
+            .map(|(a, b)| {
+                let e = patch.evaluate(a as f64 / samples as f64, b as f64 / samples as f64);
+                e.su.cross(&e.sv).norm()
+            })
+            .fold(0.0, f64::max);
+        if max_area.is_nan() || max_area <= 1e-12 * size * size {
+            return Err(Error::input(
+                "bezier patch area element max |S_u x S_v|",
+                max_area,
+                "must be > 0: the patch is degenerate (control points coincide or lie on a curve)",
+            ));
+        }
+        Ok(patch)
+    }
+
+    /// The same patch with the opposite outward normal.
+    pub fn flipped(mut self) -> BezierPatch {
+        self.flip = !self.flip;
+        self
+    }
+
+    pub fn degrees(&self) -> (usize, usize) {
+        (self.degree_u, self.degree_v)
+    }
+
+    pub fn points(&self) -> &[Vec3] {
+        &self.points
+    }
+
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// True if the outward normal is `-S_u x S_v`.
+    pub fn is_flipped(&self) -> bool {
+        self.flip
+    }
+
+    /// Axis-aligned box of the control points; it contains the patch (convex hull property).
+    pub fn bounding_box(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::repeat(f64::INFINITY);
+        let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+        for p in &self.points {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        (lo, hi)
+    }
+
+    /// Diagonal of the bounding box: the length scale of tolerances.
+    pub fn extent(&self) -> f64 {
+        let (lo, hi) = self.bounding_box();
+        (hi - lo).norm()
+    }
+
+    /// Point, first and second derivatives at `(u, v)` (any real values; the patch is
+    /// usually queried on `[0, 1]^2`).
+    pub fn evaluate(&self, u: f64, v: f64) -> PatchPoint {
+        let (bu, du, ddu) = bernstein_with_derivatives(self.degree_u, u);
+        let (bv, dv, ddv) = bernstein_with_derivatives(self.degree_v, v);
+        // Homogeneous sums: index 0 value, 1 d/du, 2 d/dv, 3 d2/du2, 4 d2/dudv, 5 d2/dv2.
+        let mut a = [Vec3::zeros(); 6];
+        let mut w = [0.0; 6];
+        let nv = self.degree_v + 1;
+        for i in 0..=self.degree_u {
+            for j in 0..nv {
+                let wij = self.weights[i * nv + j];
+                let pij = self.points[i * nv + j] * wij;
+                let basis = [
+                    bu[i] * bv[j],
+                    du[i] * bv[j],
+                    bu[i] * dv[j],
+                    ddu[i] * bv[j],
+                    du[i] * dv[j],
+                    bu[i] * ddv[j],
+                ];
+                for k in 0..6 {
+                    a[k] += pij * basis[k];
+                    w[k] += wij * basis[k];
+                }
+            }
+        }
+        let s = a[0] / w[0];
+        let su = (a[1] - s * w[1]) / w[0];
+        let sv = (a[2] - s * w[2]) / w[0];
+        PatchPoint {
+            point: s,
+            su,
+            sv,
+            suu: (a[3] - su * (2.0 * w[1]) - s * w[3]) / w[0],
+            suv: (a[4] - sv * w[1] - su * w[2] - s * w[4]) / w[0],
+            svv: (a[5] - sv * (2.0 * w[2]) - s * w[5]) / w[0],
+        }
+    }
+
+    /// Unit outward normal `±(S_u x S_v)/|S_u x S_v|` at an evaluated point, or `None` where
+    /// the patch is degenerate (`|S_u x S_v| <= 1e-14 |S_u| |S_v|`, e.g. a collapsed edge).
+    pub fn normal(&self, e: &PatchPoint) -> Option<Vec3> {
+        let c = e.su.cross(&e.sv);
+        let len = c.norm();
+        if len.is_nan() || len == 0.0 || len <= 1e-14 * e.su.norm() * e.sv.norm() {
+            return None;
+        }
+        Some(if self.flip { -c / len } else { c / len })
+    }
+
+    /// Quarter of a cylinder of radius `radius` around the axis through `axis_point` along
+    /// `axis_direction`, from angle `start_angle` (measured around the axis from
+    /// `reference`, made orthogonal to the axis) to `start_angle + 90°`, and `length` along
+    /// the axis. Degree 2 x 1 with weights `1, 1/sqrt2, 1` (exact circle). `u` runs around,
+    /// `v` along the axis; the normal points away from the axis.
+    pub fn quarter_cylinder(
+        axis_point: Vec3,
+        axis_direction: Vec3,
+        reference: Vec3,
+        start_angle: f64,
+        radius: f64,
+        length: f64,
+    ) -> Result<BezierPatch> {
+        let c = finite_vec3("quarter cylinder axis point", &axis_point)?;
+        let (a, e1, e2) = frame("quarter cylinder", &axis_direction, &reference, start_angle)?;
+        let r = positive_length("quarter cylinder radius", radius)?;
+        let l = positive_length("quarter cylinder length", length)?;
+        let (ring, ring_w) = quarter_circle(e1 * r, e2 * r);
+        let mut points = Vec::new();
+        let mut weights = Vec::new();
+        for (p, w) in ring.iter().zip(ring_w) {
+            for t in [0.0, l] {
+                points.push(c + p + a * t);
+                weights.push(w);
+            }
+        }
+        BezierPatch::new(2, 1, points, weights)
+    }
+
+    /// Quarter-by-quarter piece of a torus around the axis through `center` along `axis`:
+    /// major radius `major` (centre circle), minor radius `minor < major` (tube). `u` runs
+    /// around the axis from `major_start` (measured from `reference`) over 90°; `v` runs
+    /// around the tube from `minor_start` over 90°, the minor angle `phi` measured from the
+    /// outward radial direction towards `axis`. Degree 2 x 2, weights `w_i w_j` with
+    /// `w = (1, 1/sqrt2, 1)`: the surface of revolution of an exact circle. The normal points
+    /// out of the tube.
+    pub fn quarter_torus(
+        center: Vec3,
+        axis: Vec3,
+        reference: Vec3,
+        major_start: f64,
+        minor_start: f64,
+        major: f64,
+        minor: f64,
+    ) -> Result<BezierPatch> {
+        let c = finite_vec3("quarter torus center", &center)?;
+        let (a, e1, e2) = frame("quarter torus", &axis, &reference, major_start)?;
+        let big = positive_length("quarter torus major radius", major)?;
+        let small = positive_length("quarter torus minor radius", minor)?;
+        if small >= big {
+            return Err(Error::input(
+                "quarter torus minor radius",
+                small,
+                &format!("must be < the major radius {big}"),
+            ));
+        }
+        if !minor_start.is_finite() {
+            return Err(Error::input(
+                "quarter torus minor start angle",
+                minor_start,
+                "must be finite",
+            ));
+        }
+        // Profile circle in the (radial, axial) half-plane, as 2-D points (rho, z).
+        let (cs, sn) = (minor_start.cos(), minor_start.sin());
+        let (profile, profile_w) = quarter_circle(
+            Vec3::new(cs, sn, 0.0) * small,
+            Vec3::new(-sn, cs, 0.0) * small,
+        );
+        let (ring, ring_w) = quarter_circle(e1, e2);
+        let mut points = Vec::new();
+        let mut weights = Vec::new();
+        for (d, wu) in ring.iter().zip(ring_w) {
+            for (q, wv) in profile.iter().zip(profile_w) {
+                // Revolving a control point (rho, z) about the axis: rho scales the ring's
+                // control direction (the middle one has length sqrt2, as it must).
+                points.push(c + d * (big + q.x) + a * q.y);
+                weights.push(wu * wv);
+            }
+        }
+        BezierPatch::new(2, 2, points, weights)
+    }
+}
+
+/// Unit axis `a` and an orthonormal pair `(e1, e2)` across it, `e1` at `angle` from
+/// `reference` around `a`, `e2 = a x e1`.
+fn frame(what: &str, axis: &Vec3, reference: &Vec3, angle: f64) -> Result<(Vec3, Vec3, Vec3)> {
+    let a = unit_vec3(&format!("{what} axis"), axis)?;
+    let r = finite_vec3(&format!("{what} reference direction"), reference)?;
+    let across = r - a * a.dot(&r);
+    let across_len = across.norm();
+    if across_len.is_nan() || across_len <= 1e-12 * r.norm() {
+        return Err(Error::input(
+            &format!("{what} reference direction"),
+            fmt_vec3(&r),
+            "must not be parallel to the axis",
+        ));
+    }
+    if !angle.is_finite() {
+        return Err(Error::input(
+            &format!("{what} start angle"),
+            angle,
+            "must be finite",
+        ));
+    }
+    let f1 = across.normalize();
+    let f2 = a.cross(&f1);
+    let e1 = f1 * angle.cos() + f2 * angle.sin();
+    Ok((a, e1, a.cross(&e1)))
+}
+
+/// Rational quadratic quarter circle from `p` to `q` (orthogonal, equal length, centred at
+/// the origin): control points `p, p + q, q`, weights `1, 1/sqrt2, 1`.
+fn quarter_circle(p: Vec3, q: Vec3) -> ([Vec3; 3], [f64; 3]) {
+    ([p, p + q, q], [1.0, std::f64::consts::FRAC_1_SQRT_2, 1.0])
+}
+
+#[cfg(test)]
+/// A wavy rational bicubic-by-quadratic patch with random weights in `[0.5, 2]`.
+pub(crate) fn random_patch(rng: &mut crate::geometry::testutil::Rng) -> BezierPatch {
+    let (p, q) = (3, 2);
+    let mut points = Vec::new();
+    let mut weights = Vec::new();
+    for i in 0..=p {
+        for j in 0..=q {
+            points.push(Vec3::new(i as f64, j as f64 * 1.5, rng.uniform(-0.4, 0.4)));
+            weights.push(rng.uniform(0.5, 2.0));
+        }
+    }
+    BezierPatch::new(p, q, points, weights).unwrap()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::testutil::*;
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let mut rng = Rng::new(41);
+        let h = 1e-5;
+        for _ in 0..50 {
+            let patch = random_patch(&mut rng);
+            let (u, v) = (rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+            let e = patch.evaluate(u, v);
+            let (up, um) = (patch.evaluate(u + h, v), patch.evaluate(u - h, v));
+            let (vp, vm) = (patch.evaluate(u, v + h), patch.evaluate(u, v - h));
+            let close = |a: Vec3, b: Vec3, tol: f64| {
+                assert!((a - b).norm() < tol * (1.0 + b.norm()), "{a:?} vs {b:?}")
+            };
+            close((up.point - um.point) / (2.0 * h), e.su, 1e-8);
+            close((vp.point - vm.point) / (2.0 * h), e.sv, 1e-8);
+            close((up.su - um.su) / (2.0 * h), e.suu, 1e-7);
+            close((vp.sv - vm.sv) / (2.0 * h), e.svv, 1e-7);
+            close((vp.su - vm.su) / (2.0 * h), e.suv, 1e-7);
+            close((up.sv - um.sv) / (2.0 * h), e.suv, 1e-7);
+        }
+    }
+
+    #[test]
+    fn quarter_cylinder_is_exact() {
+        let mut rng = Rng::new(42);
+        let axis = Vec3::new(0.3, -1.0, 0.5).normalize();
+        let c = Vec3::new(1.0, 2.0, -1.0);
+        let patch = BezierPatch::quarter_cylinder(c, axis, Vec3::x(), 0.7, 2.5, 4.0).unwrap();
+        for _ in 0..100 {
+            let e = patch.evaluate(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+            let rel = e.point - c;
+            let across = rel - axis * axis.dot(&rel);
+            assert!((across.norm() - 2.5).abs() < 1e-13);
+            let n = patch.normal(&e).unwrap();
+            assert!(
+                (n - across / 2.5).norm() < 1e-13,
+                "normal points away from the axis"
+            );
+        }
+    }
+
+    #[test]
+    fn quarter_torus_is_exact() {
+        let mut rng = Rng::new(43);
+        let axis = Vec3::new(0.2, 0.1, 1.0).normalize();
+        let c = Vec3::new(-1.0, 0.5, 2.0);
+        let patch = BezierPatch::quarter_torus(c, axis, Vec3::y(), 0.3, -1.0, 4.0, 1.5).unwrap();
+        for _ in 0..100 {
+            let e = patch.evaluate(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+            let rel = e.point - c;
+            let across = rel - axis * axis.dot(&rel);
+            let tube_centre = c + across.normalize() * 4.0;
+            assert!(((e.point - tube_centre).norm() - 1.5).abs() < 1e-13);
+            let n = patch.normal(&e).unwrap();
+            assert!((n - (e.point - tube_centre) / 1.5).norm() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn degenerate_point_gives_no_normal_and_no_nan() {
+        // A triangle-like patch: the edge u = 0 collapses to one point.
+        let apex = Vec3::new(0.0, 0.0, 1.0);
+        let points = vec![
+            apex,
+            apex,
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+        ];
+        let patch = BezierPatch::new(1, 1, points, vec![1.0; 4]).unwrap();
+        let e = patch.evaluate(0.0, 0.5);
+        assert!(e.point.iter().chain(e.su.iter()).all(|c| c.is_finite()));
+        assert!(patch.normal(&e).is_none());
+        assert!(patch.normal(&patch.evaluate(0.5, 0.5)).is_some());
+    }
+
+    #[test]
+    fn invalid_patches_are_refused() {
+        let msg = |r: Result<BezierPatch>| r.unwrap_err().to_string();
+        let p = Vec3::new(1.0, 2.0, 3.0);
+        let err = msg(BezierPatch::new(1, 1, vec![p; 4], vec![1.0; 4]));
+        assert!(err.contains("the patch is degenerate"), "{err}");
+        let grid = vec![
+            Vec3::zeros(),
+            Vec3::y(),
+            Vec3::x(),
+            Vec3::new(1.0, 1.0, 0.0),
+        ];
+        let err = msg(BezierPatch::new(
+            1,
+            1,
+            grid.clone(),
+            vec![1.0, 1.0, 0.0, 1.0],
+        ));
+        assert!(
+            err.contains("bezier patch weight [1][0] = 0 must be > 0"),
+            "{err}"
+        );
+        let err = msg(BezierPatch::new(
+            1,
+            1,
+            grid.clone(),
+            vec![1.0, -2.0, 1.0, 1.0],
+        ));
+        assert!(
+            err.contains("bezier patch weight [0][1] = -2 must be > 0"),
+            "{err}"
+        );
+        let err = msg(BezierPatch::new(1, 1, grid.clone(), vec![1.0; 3]));
+        assert!(
+            err.contains("bezier patch weight count = 3 must be"),
+            "{err}"
+        );
+        let err = msg(BezierPatch::new(2, 1, grid.clone(), vec![1.0; 6]));
+        assert!(
+            err.contains(
+                "bezier patch control point count = 4 must be (degree_u + 1) * (degree_v + 1) = 6"
+            ),
+            "{err}"
+        );
+        let err = msg(BezierPatch::new(0, 1, grid[..2].to_vec(), vec![1.0; 2]));
+        assert!(
+            err.contains("bezier patch degree_u = 0 must be >= 1"),
+            "{err}"
+        );
+        let mut bad = grid.clone();
+        bad[3].z = f64::NAN;
+        let err = msg(BezierPatch::new(1, 1, bad, vec![1.0; 4]));
+        assert!(
+            err.contains("bezier patch control point [1][1] = (1, 1, NaN) must be finite"),
+            "{err}"
+        );
+        let err = msg(BezierPatch::quarter_torus(
+            p,
+            Vec3::z(),
+            Vec3::x(),
+            0.0,
+            0.0,
+            1.0,
+            2.0,
+        ));
+        assert!(
+            err.contains("quarter torus minor radius = 2 must be < the major radius 1"),
+            "{err}"
+        );
+        let err = msg(BezierPatch::quarter_cylinder(
+            p,
+            Vec3::z(),
+            Vec3::z(),
+            0.0,
+            1.0,
+            1.0,
+        ));
+        assert!(err.contains("must not be parallel to the axis"), "{err}");
+    }
+}
