@@ -1,6 +1,6 @@
 //! Per-node contact history, committed only when an increment converges.
 
-use super::ContactStatus;
+use super::{ContactStatus, FrictionInput};
 use crate::geometry::{SurfaceHint, Vec3};
 
 /// The committed state of one (tool, node) contact pair.
@@ -39,5 +39,15 @@ impl ContactNodeState {
     /// Norm of the tangential multiplier.
     pub fn lambda_t_norm(&self) -> f64 {
         (self.lambda - self.normal * self.lambda_n()).norm()
+    }
+
+    /// What a friction law sees of this node, whose tributary area is `area`.
+    pub fn friction_input(&self, area: f64) -> FrictionInput {
+        FrictionInput {
+            work: self.work,
+            slip: self.slip,
+            pressure: -self.lambda_n() / area.max(f64::MIN_POSITIVE),
+            area,
+        }
     }
 }

@@ -181,7 +181,7 @@ impl IncrementContext<'_> {
         }
         times.elements += t0.elapsed().as_secs_f64();
 
-        let f_ext = self.external_forces();
+        let f_ext = model.external_forces(self.time);
         for d in 0..3 * self.dofs.n_nodes {
             residual[d] = f_int[d] - f_ext[d];
         }
@@ -301,19 +301,6 @@ impl IncrementContext<'_> {
             f_ext,
             support_forces,
         })
-    }
-
-    pub fn external_forces(&self) -> Vec<f64> {
-        let mut f = vec![0.0; 3 * self.dofs.n_nodes];
-        for load in &self.model.loads {
-            let total = load.total * load.scale.value(self.time);
-            for (&node, &w) in load.nodes.iter().zip(&load.weights) {
-                for i in 0..3 {
-                    f[3 * node + i] += w * total[i];
-                }
-            }
-        }
-        f
     }
 }
 

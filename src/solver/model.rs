@@ -190,6 +190,21 @@ impl Model {
         Ok(())
     }
 
+    /// Nodal external forces at time `t` (3 per node): every load's total spread by its
+    /// weights.
+    pub fn external_forces(&self, t: f64) -> Vec<f64> {
+        let mut f = vec![0.0; 3 * self.mesh.nodes.len()];
+        for load in &self.loads {
+            let total = load.total * load.scale.value(t);
+            for (&node, &w) in load.nodes.iter().zip(&load.weights) {
+                for i in 0..3 {
+                    f[3 * node + i] += w * total[i];
+                }
+            }
+        }
+        f
+    }
+
     pub fn tool_index(&self, name: &str) -> Result<usize> {
         self.contacts
             .iter()

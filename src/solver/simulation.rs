@@ -116,18 +116,7 @@ impl Simulation {
             })
             .collect();
         let dofs_nodes = dofs.n_nodes;
-        let initial_f_ext = {
-            let mut f = vec![0.0; 3 * dofs_nodes];
-            for load in &model.loads {
-                let total = load.total * load.scale.value(0.0);
-                for (&node, &w) in load.nodes.iter().zip(&load.weights) {
-                    for i in 0..3 {
-                        f[3 * node + i] += w * total[i];
-                    }
-                }
-            }
-            f
-        };
+        let initial_f_ext = model.external_forces(0.0);
         let condenser = if model.settings.eliminate_multipliers {
             Condenser::new(&model, &dofs, &pattern, &is_fixed)
         } else {
@@ -198,18 +187,18 @@ impl Simulation {
     /// Reaction force on the nodes of a Dirichlet node set at the committed state.
     pub fn reaction(&mut self, nodes: &[usize]) -> Result<Vec3> {
         let eval = self.evaluate_at(self.time, &self.x.clone())?;
+        let mut in_set = vec![false; self.dofs.n_nodes];
         let mut r = Vec3::zeros();
         for &node in nodes {
+            in_set[node] = true;
             for i in 0..3 {
-                let d = 3 * node + i;
-                let contact: f64 = 0.0;
-                r[i] += eval.f_int[d] - eval.f_ext[d] + contact;
+                r[i] += eval.f_int[3 * node + i] - eval.f_ext[3 * node + i];
             }
         }
         // Contact forces on these nodes also load the support.
         for (c, contact) in self.model.contacts.iter().enumerate() {
             for (k, &node) in contact.candidates.iter().enumerate() {
-                if nodes.contains(&node) {
+                if in_set[node] {
                     r += eval.nodal[c][k].0.f_equi;
                 }
             }
@@ -493,9 +482,8 @@ impl Simulation {
                     s.work += lambda_t.dot(&res.slip_increment).max(0.0);
                     s.slip += res.slip_increment.norm();
                 }
-                let stick_slip = |st: ContactStatus| st.is_active();
-                if stick_slip(previous_status)
-                    && stick_slip(res.status)
+                if previous_status.is_active()
+                    && res.status.is_active()
                     && previous_status != res.status
                 {
                     s.flips += 1;
@@ -504,13 +492,7 @@ impl Simulation {
                 slipping += usize::from(res.status == ContactStatus::Slip);
                 s.x_ref_local = pose.to_local(&xn);
                 let area = contact.areas[k];
-                let input = FrictionInput {
-                    work: s.work,
-                    slip: s.slip,
-                    pressure: -s.lambda_n() / area.max(f64::MIN_POSITIVE),
-                    area,
-                };
-                if let Some(mu) = contact.tool.friction.mu(&input) {
+                if let Some(mu) = contact.tool.friction.mu(&s.friction_input(area)) {
                     s.mu = mu;
                 }
                 s.theta = contact
@@ -604,12 +586,7 @@ impl Simulation {
         self.contact[c]
             .iter()
             .zip(&contact.areas)
-            .map(|(s, &area)| FrictionInput {
-                work: s.work,
-                slip: s.slip,
-                pressure: -s.lambda_n() / area.max(f64::MIN_POSITIVE),
-                area,
-            })
+            .map(|(s, &area)| s.friction_input(area))
             .collect()
     }
 
