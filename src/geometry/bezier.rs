@@ -258,11 +258,7 @@ impl BezierPatch {
         Some(if self.flip { -c / len } else { c / len })
     }
 
-    /// Quarter of a cylinder of radius `radius` around the axis through `axis_point` along
-    /// `axis_direction`, from angle `start_angle` (measured around the axis from
-    /// `reference`, made orthogonal to the axis) to `start_angle + 90°`, and `length` along
-    /// the axis. Degree 2 x 1 with weights `1, 1/sqrt2, 1` (exact circle). `u` runs around,
-    /// `v` along the axis; the normal points away from the axis.
+    /// Quarter of a cylinder: [`BezierPatch::cylinder_patch`] with a 90° sweep.
     pub fn quarter_cylinder(
         axis_point: Vec3,
         axis_direction: Vec3,
@@ -271,11 +267,36 @@ impl BezierPatch {
         radius: f64,
         length: f64,
     ) -> Result<BezierPatch> {
-        let c = finite_vec3("quarter cylinder axis point", &axis_point)?;
-        let (a, e1, e2) = frame("quarter cylinder", &axis_direction, &reference, start_angle)?;
-        let r = positive_length("quarter cylinder radius", radius)?;
-        let l = positive_length("quarter cylinder length", length)?;
-        let (ring, ring_w) = quarter_circle(e1 * r, e2 * r);
+        BezierPatch::cylinder_patch(
+            axis_point,
+            axis_direction,
+            reference,
+            start_angle,
+            std::f64::consts::FRAC_PI_2,
+            radius,
+            length,
+        )
+    }
+
+    /// Piece of a cylinder of radius `radius` around the axis through `axis_point` along
+    /// `axis_direction`, from angle `start_angle` (measured around the axis from
+    /// `reference`, made orthogonal to the axis) over `sweep` (0 < sweep <= 120°), and
+    /// `length` along the axis. Degree 2 x 1 with weights `1, cos(sweep/2), 1` (exact
+    /// circle). `u` runs around, `v` along the axis; the normal points away from the axis.
+    pub fn cylinder_patch(
+        axis_point: Vec3,
+        axis_direction: Vec3,
+        reference: Vec3,
+        start_angle: f64,
+        sweep: f64,
+        radius: f64,
+        length: f64,
+    ) -> Result<BezierPatch> {
+        let c = finite_vec3("cylinder patch axis point", &axis_point)?;
+        let (a, e1, e2) = frame("cylinder patch", &axis_direction, &reference, start_angle)?;
+        let r = positive_length("cylinder patch radius", radius)?;
+        let l = positive_length("cylinder patch length", length)?;
+        let (ring, ring_w) = circular_arc("cylinder patch sweep", e1 * r, e2 * r, sweep)?;
         let mut points = Vec::new();
         let mut weights = Vec::new();
         for (p, w) in ring.iter().zip(ring_w) {
@@ -287,13 +308,7 @@ impl BezierPatch {
         BezierPatch::new(2, 1, points, weights)
     }
 
-    /// Quarter-by-quarter piece of a torus around the axis through `center` along `axis`:
-    /// major radius `major` (centre circle), minor radius `minor < major` (tube). `u` runs
-    /// around the axis from `major_start` (measured from `reference`) over 90°; `v` runs
-    /// around the tube from `minor_start` over 90°, the minor angle `phi` measured from the
-    /// outward radial direction towards `axis`. Degree 2 x 2, weights `w_i w_j` with
-    /// `w = (1, 1/sqrt2, 1)`: the surface of revolution of an exact circle. The normal points
-    /// out of the tube.
+    /// Quarter-by-quarter piece of a torus: [`BezierPatch::torus_patch`] with 90° sweeps.
     pub fn quarter_torus(
         center: Vec3,
         axis: Vec3,
@@ -303,42 +318,105 @@ impl BezierPatch {
         major: f64,
         minor: f64,
     ) -> Result<BezierPatch> {
-        let c = finite_vec3("quarter torus center", &center)?;
-        let (a, e1, e2) = frame("quarter torus", &axis, &reference, major_start)?;
-        let big = positive_length("quarter torus major radius", major)?;
-        let small = positive_length("quarter torus minor radius", minor)?;
+        let quarter = std::f64::consts::FRAC_PI_2;
+        BezierPatch::torus_patch(
+            center,
+            axis,
+            reference,
+            [major_start, quarter],
+            [minor_start, quarter],
+            major,
+            minor,
+        )
+    }
+
+    /// Piece of a torus around the axis through `center` along `axis`: major radius `major`
+    /// (centre circle), minor radius `minor < major` (tube). `u` runs around the axis from
+    /// `major_angles[0]` (measured from `reference`) over `major_angles[1]`; `v` runs around
+    /// the tube from `minor_angles[0]` over `minor_angles[1]`, the minor angle `phi`
+    /// measured from the outward radial direction towards `axis`. Sweeps in (0, 120°].
+    /// Degree 2 x 2, weights `w_i w_j` of the two arcs: the surface of revolution of an
+    /// exact circle. The normal points out of the tube.
+    pub fn torus_patch(
+        center: Vec3,
+        axis: Vec3,
+        reference: Vec3,
+        major_angles: [f64; 2],
+        minor_angles: [f64; 2],
+        major: f64,
+        minor: f64,
+    ) -> Result<BezierPatch> {
+        let c = finite_vec3("torus patch center", &center)?;
+        let (a, e1, e2) = frame("torus patch", &axis, &reference, major_angles[0])?;
+        let big = positive_length("torus patch major radius", major)?;
+        let small = positive_length("torus patch minor radius", minor)?;
         if small >= big {
             return Err(Error::input(
-                "quarter torus minor radius",
+                "torus patch minor radius",
                 small,
                 &format!("must be < the major radius {big}"),
             ));
         }
+        let minor_start = minor_angles[0];
         if !minor_start.is_finite() {
             return Err(Error::input(
-                "quarter torus minor start angle",
+                "torus patch minor start angle",
                 minor_start,
                 "must be finite",
             ));
         }
         // Profile circle in the (radial, axial) half-plane, as 2-D points (rho, z).
         let (cs, sn) = (minor_start.cos(), minor_start.sin());
-        let (profile, profile_w) = quarter_circle(
+        let (profile, profile_w) = circular_arc(
+            "torus patch minor sweep",
             Vec3::new(cs, sn, 0.0) * small,
             Vec3::new(-sn, cs, 0.0) * small,
-        );
-        let (ring, ring_w) = quarter_circle(e1, e2);
+            minor_angles[1],
+        )?;
+        let (ring, ring_w) = circular_arc("torus patch major sweep", e1, e2, major_angles[1])?;
         let mut points = Vec::new();
         let mut weights = Vec::new();
         for (d, wu) in ring.iter().zip(ring_w) {
             for (q, wv) in profile.iter().zip(profile_w) {
                 // Revolving a control point (rho, z) about the axis: rho scales the ring's
-                // control direction (the middle one has length sqrt2, as it must).
+                // control direction (the middle one has length 1/cos(sweep/2), as it must).
                 points.push(c + d * (big + q.x) + a * q.y);
                 weights.push(wu * wv);
             }
         }
         BezierPatch::new(2, 2, points, weights)
+    }
+
+    /// Bilinear flat patch with corners `origin`, `origin + edge_u`, `origin + edge_v`,
+    /// `origin + edge_u + edge_v` (a parallelogram); the normal is along `edge_u x edge_v`.
+    pub fn parallelogram(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Result<BezierPatch> {
+        let o = finite_vec3("flat patch corner", &origin)?;
+        let eu = finite_vec3("flat patch edge_u", &edge_u)?;
+        let ev = finite_vec3("flat patch edge_v", &edge_v)?;
+        BezierPatch::new(1, 1, vec![o, o + ev, o + eu, o + eu + ev], vec![1.0; 4])
+    }
+
+    /// The patch moved rigidly, `x -> R x + t` (exact: control points transform, weights
+    /// do not). `R` must be a rotation (not checked beyond finiteness by the caller).
+    pub fn transformed(&self, rotation: &Mat3, translation: &Vec3) -> BezierPatch {
+        BezierPatch {
+            points: self
+                .points
+                .iter()
+                .map(|p| rotation * p + translation)
+                .collect(),
+            ..self.clone()
+        }
+    }
+
+    /// The patch flipped if needed so that its normal at the parameter centre has a
+    /// positive component along `outward`.
+    pub fn oriented(self, outward: &Vec3) -> BezierPatch {
+        let e = self.evaluate(0.5, 0.5);
+        match self.normal(&e) {
+            Some(n) if n.dot(outward) < 0.0 => self.flipped(),
+            _ => self,
+        }
     }
 }
 
@@ -369,10 +447,28 @@ fn frame(what: &str, axis: &Vec3, reference: &Vec3, angle: f64) -> Result<(Vec3,
     Ok((a, e1, a.cross(&e1)))
 }
 
-/// Rational quadratic quarter circle from `p` to `q` (orthogonal, equal length, centred at
-/// the origin): control points `p, p + q, q`, weights `1, 1/sqrt2, 1`.
-fn quarter_circle(p: Vec3, q: Vec3) -> ([Vec3; 3], [f64; 3]) {
-    ([p, p + q, q], [1.0, std::f64::consts::FRAC_1_SQRT_2, 1.0])
+/// Rational quadratic arc of angle `sweep` from `p` to `p` rotated by `sweep` towards `q`
+/// (`p`, `q` orthogonal, equal length, centred at the origin): control points `p`,
+/// `(p + tan(sweep/2) q) `, end, weights `1, cos(sweep/2), 1`. The 90° arc uses the exact
+/// values `p + q` and `1/sqrt2`. Sweeps in (0, 120°] (beyond, the middle weight gets small
+/// and the parametrisation uneven).
+fn circular_arc(what: &str, p: Vec3, q: Vec3, sweep: f64) -> Result<([Vec3; 3], [f64; 3])> {
+    let limit = 2.0 * std::f64::consts::FRAC_PI_3;
+    if !sweep.is_finite() || sweep <= 0.0 || sweep > limit * (1.0 + 1e-12) {
+        return Err(Error::input(
+            what,
+            sweep.to_degrees(),
+            "(degrees) must be in (0, 120]",
+        ));
+    }
+    if sweep == std::f64::consts::FRAC_PI_2 {
+        return Ok(([p, p + q, q], [1.0, std::f64::consts::FRAC_1_SQRT_2, 1.0]));
+    }
+    let half = 0.5 * sweep;
+    Ok((
+        [p, p + q * half.tan(), p * sweep.cos() + q * sweep.sin()],
+        [1.0, half.cos(), 1.0],
+    ))
 }
 
 #[cfg(test)]
@@ -536,7 +632,7 @@ mod tests {
             2.0,
         ));
         assert!(
-            err.contains("quarter torus minor radius = 2 must be < the major radius 1"),
+            err.contains("torus patch minor radius = 2 must be < the major radius 1"),
             "{err}"
         );
         let err = msg(BezierPatch::quarter_cylinder(
