@@ -331,7 +331,7 @@ impl BezierPatch {
     }
 
     /// Piece of a torus around the axis through `center` along `axis`: major radius `major`
-    /// (centre circle), minor radius `minor < major` (tube). `u` runs around the axis from
+    /// (centre circle), minor radius `minor` (tube; it may exceed `major` if the patch keeps off the axis). `u` runs around the axis from
     /// `major_angles[0]` (measured from `reference`) over `major_angles[1]`; `v` runs around
     /// the tube from `minor_angles[0]` over `minor_angles[1]`, the minor angle `phi`
     /// measured from the outward radial direction towards `axis`. Sweeps in (0, 120°].
@@ -350,19 +350,37 @@ impl BezierPatch {
         let (a, e1, e2) = frame("torus patch", &axis, &reference, major_angles[0])?;
         let big = positive_length("torus patch major radius", major)?;
         let small = positive_length("torus patch minor radius", minor)?;
-        if small >= big {
-            return Err(Error::input(
-                "torus patch minor radius",
-                small,
-                &format!("must be < the major radius {big}"),
-            ));
-        }
         let minor_start = minor_angles[0];
         if !minor_start.is_finite() {
             return Err(Error::input(
                 "torus patch minor start angle",
                 minor_start,
                 "must be finite",
+            ));
+        }
+        // The tube may be wider than the centre circle (a spindle torus, as at a punch's
+        // nose corner) as long as the patch keeps off the axis: the distance to the axis
+        // major + minor cos(phi) stays positive over the patch's minor angles.
+        let end = minor_start + minor_angles[1];
+        let crosses_pi = ((minor_start - std::f64::consts::PI) / std::f64::consts::TAU).ceil()
+            <= ((end - std::f64::consts::PI) / std::f64::consts::TAU).floor();
+        let (phi_min, cos_min) = if crosses_pi {
+            (std::f64::consts::PI, -1.0)
+        } else if minor_start.cos() < end.cos() {
+            (minor_start, minor_start.cos())
+        } else {
+            (end, end.cos())
+        };
+        let closest = big + small * cos_min;
+        if closest <= 1e-9 * big {
+            return Err(Error::input(
+                "torus patch minor radius",
+                small,
+                &format!(
+                    "must keep the patch off the axis: major + minor cos(phi) = {closest} at \
+                     phi = {}°",
+                    phi_min.to_degrees()
+                ),
             ));
         }
         // Profile circle in the (radial, axial) half-plane, as 2-D points (rho, z).
@@ -627,12 +645,12 @@ mod tests {
             Vec3::z(),
             Vec3::x(),
             0.0,
-            0.0,
+            std::f64::consts::FRAC_PI_2,
             1.0,
             2.0,
         ));
         assert!(
-            err.contains("torus patch minor radius = 2 must be < the major radius 1"),
+            err.contains("torus patch minor radius = 2 must keep the patch off the axis: major + minor cos(phi) = -1 at phi = 180°"),
             "{err}"
         );
         let err = msg(BezierPatch::quarter_cylinder(
