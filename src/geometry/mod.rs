@@ -13,6 +13,7 @@ pub mod bvh;
 mod check;
 pub mod cylinder;
 pub mod patch_surface;
+pub mod patch_table;
 pub mod plane;
 pub mod seams;
 pub mod sphere;
