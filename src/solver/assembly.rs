@@ -284,7 +284,15 @@ impl IncrementContext<'_> {
             }
             nodal.push(list);
         }
-        force_control::add_force_rows(model, self.dofs, self.time, x, &nodal, &mut residual, &mut jac)?;
+        force_control::add_force_rows(
+            model,
+            self.dofs,
+            self.time,
+            x,
+            &nodal,
+            &mut residual,
+            &mut jac,
+        )?;
         times.contact += t1.elapsed().as_secs_f64();
 
         let support_forces: Vec<f64> = (0..3 * self.dofs.n_nodes)

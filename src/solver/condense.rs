@@ -73,8 +73,7 @@ impl Condenser {
         let mut eliminated = Vec::new();
         for (c, contact) in model.contacts.iter().enumerate() {
             // A force-controlled tool's row couples all its multipliers: they stay.
-            let Some(off) = dofs.lambda_offset[c].filter(|_| dofs.tool_offset[c].is_none())
-            else {
+            let Some(off) = dofs.lambda_offset[c].filter(|_| dofs.tool_offset[c].is_none()) else {
                 continue;
             };
             for (k, &node) in contact.candidates.iter().enumerate() {

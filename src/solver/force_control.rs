@@ -59,7 +59,11 @@ pub fn check(model: &Model) -> Result<()> {
 
 /// Allocates the offset unknowns after `next`: one per force-controlled tool that has
 /// multipliers.
-pub fn allocate(model: &Model, lambda_offset: &[Option<usize>], next: &mut usize) -> Vec<Option<usize>> {
+pub fn allocate(
+    model: &Model,
+    lambda_offset: &[Option<usize>],
+    next: &mut usize,
+) -> Vec<Option<usize>> {
     model
         .contacts
         .iter()

@@ -41,7 +41,8 @@ mod tests {
 
     #[test]
     fn axis_is_normalised_and_zero_refused() {
-        let f = ForceControl::new(Vec3::new(0.0, 0.0, -2.0), ScalarSchedule::constant(1.0)).unwrap();
+        let f =
+            ForceControl::new(Vec3::new(0.0, 0.0, -2.0), ScalarSchedule::constant(1.0)).unwrap();
         assert_eq!(f.axis, Vec3::new(0.0, 0.0, -1.0));
         let err = ForceControl::new(Vec3::zeros(), ScalarSchedule::constant(1.0)).unwrap_err();
         assert!(err.to_string().contains("force-control axis"), "{err}");
