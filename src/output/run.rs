@@ -41,6 +41,14 @@ impl RunOutput {
         for c in &sim.model.contacts {
             columns.push(format!("{}_frictional_dissipation", c.tool.name));
         }
+        for c in sim
+            .model
+            .contacts
+            .iter()
+            .filter(|c| c.tool.force_control.is_some())
+        {
+            columns.push(format!("{}_offset", c.tool.name));
+        }
         for name in [
             "tool_work",
             "load_work",
@@ -64,7 +72,7 @@ impl RunOutput {
     }
 
     /// Appends the increment's row to history.csv.
-    pub fn record(&mut self, _sim: &Simulation, r: &IncrementReport) -> Result<()> {
+    pub fn record(&mut self, sim: &Simulation, r: &IncrementReport) -> Result<()> {
         let last = r.residuals.last();
         let mut row = vec![
             r.index as f64,
@@ -82,6 +90,11 @@ impl RunOutput {
         }
         let e = &r.energy;
         row.extend_from_slice(&e.frictional_dissipation);
+        for (c, contact) in sim.model.contacts.iter().enumerate() {
+            if contact.tool.force_control.is_some() {
+                row.push(r.tool_offsets[c]);
+            }
+        }
         row.extend_from_slice(&[
             e.tool_work,
             e.load_work,
@@ -125,6 +138,12 @@ impl RunOutput {
                         "work_measure": contact.tool.friction.bernstein().map(|l| l.measure().name()),
                         "frictional_dissipation": sim.energy().frictional_dissipation.get(c),
                         "candidate_nodes": contact.candidates.len(),
+                        "offset": sim.tool_offset(c),
+                        "position": <[f64; 3]>::from(sim.tool_position(c)),
+                        "force_control": contact.tool.force_control.as_ref().map(|fc| serde_json::json!({
+                            "axis": [fc.axis.x, fc.axis.y, fc.axis.z],
+                            "scheduled_force": fc.force.value(sim.time()),
+                        })),
                     }),
                 )
             })

@@ -175,6 +175,12 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
         );
     }
     m.insert("tool_forces".into(), Dynamic::from(forces));
+    let offsets: Map = tools
+        .iter()
+        .zip(&r.tool_offsets)
+        .map(|(name, s)| (name.into(), Dynamic::from(*s)))
+        .collect();
+    m.insert("tool_offsets".into(), Dynamic::from(offsets));
     m
 }
 
@@ -420,6 +426,26 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             let sim = st.simulation()?;
             let c = lift(sim.model.tool_index(name))?;
             Ok(array3(&sim.tool_force(c)))
+        },
+    );
+    // Offset of a force-controlled tool along its axis (0 for a kinematic tool).
+    engine.register_fn(
+        "tool_offset",
+        |s: &mut ScriptSim, name: &str| -> ScriptResult<f64> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let c = lift(sim.model.tool_index(name))?;
+            Ok(sim.tool_offset(c))
+        },
+    );
+    // Translation of a tool now: its schedule plus any force-control offset.
+    engine.register_fn(
+        "tool_position",
+        |s: &mut ScriptSim, name: &str| -> ScriptResult<Array> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let c = lift(sim.model.tool_index(name))?;
+            Ok(array3(&sim.tool_position(c)))
         },
     );
     engine.register_fn(
