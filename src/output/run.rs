@@ -13,6 +13,8 @@ pub struct RunOutput {
     pvd: PvdSeries,
     history: HistoryCsv,
     frames: usize,
+    /// Entries a script added to summary.json (top level, beside the built-in ones).
+    extra: serde_json::Map<String, serde_json::Value>,
 }
 
 impl RunOutput {
@@ -64,6 +66,7 @@ impl RunOutput {
             pvd,
             history,
             frames: 0,
+            extra: serde_json::Map::new(),
         })
     }
 
@@ -115,6 +118,17 @@ impl RunOutput {
         Ok(())
     }
 
+    /// Adds (or replaces) a top-level entry of summary.json, written with the next
+    /// [`write_summary`](Self::write_summary); a built-in entry's name is refused there.
+    pub fn set_summary_entry(&mut self, key: &str, value: serde_json::Value) {
+        self.extra.insert(key.to_string(), value);
+    }
+
+    /// Removes a script entry of summary.json.
+    pub fn remove_summary_entry(&mut self, key: &str) {
+        self.extra.remove(key);
+    }
+
     /// Writes summary.json; `error` records why a run stopped early.
     pub fn write_summary(
         &self,
@@ -150,7 +164,7 @@ impl RunOutput {
             .collect();
         let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();
         let settings = &sim.model.settings;
-        let summary = serde_json::json!({
+        let mut summary = serde_json::json!({
             "status": if error.is_some() { "stopped" } else if sim.is_finished() { "finished" } else { "running" },
             "error": error,
             "time": sim.time(),
@@ -177,6 +191,16 @@ impl RunOutput {
             "tools": tools,
             "frames": self.frames,
         });
+        if let Some(map) = summary.as_object_mut() {
+            for (key, value) in &self.extra {
+                if map.contains_key(key) {
+                    return Err(crate::Error::Input(format!(
+                        "summary entry '{key}' is written by the engine; choose another name"
+                    )));
+                }
+                map.insert(key.clone(), value.clone());
+            }
+        }
         write_summary(&self.folder.resolve_for_write("summary.json")?, &summary)
     }
 }
