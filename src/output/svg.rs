@@ -471,9 +471,9 @@ impl FieldMap {
         // Equal scales in x and y, the drawing fitted in a 520 x 520 box.
         let scale = 520.0 / (bx1 - bx0).max(by1 - by0);
         let (pw, ph) = ((bx1 - bx0) * scale, (by1 - by0) * scale);
-        let (left, top) = (40.0, 60.0);
+        let (left, top) = (70.0, 60.0);
         let width = left + pw + 150.0;
-        let height = top + ph.max(200.0) + 40.0;
+        let height = top + ph.max(200.0) + 50.0;
         let sx = |x: f64| left + (x - bx0) * scale;
         let sy = |y: f64| top + (by1 - y) * scale;
 
@@ -491,7 +491,7 @@ impl FieldMap {
         let n = ((MAX_POLYGONS as f64 / self.quads.len() as f64)
             .sqrt()
             .floor() as usize)
-            .clamp(1, 4);
+            .clamp(1, 8);
         // A stroke of the fill colour closes the hairline seams that anti-aliasing leaves
         // between neighbouring polygons.
         out.push_str("<g stroke-width=\"0.6\" stroke-linejoin=\"round\">\n");
@@ -541,6 +541,68 @@ impl FieldMap {
             let _ = writeln!(out, "<polygon points=\"{}\"/>", pts.join(" "));
         }
         out.push_str("</g>\n");
+        // Coordinate ticks below and left of the drawing.
+        let _ = writeln!(
+            out,
+            "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#333\" stroke-width=\"0.8\"/>",
+            px(left), px(top), px(pw), px(ph)
+        );
+        let (xt, xs) = nice_ticks(bx0, bx1, 6);
+        for t in xt {
+            let _ = writeln!(
+                out,
+                "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"#333\"/>",
+                px(sx(t)),
+                px(top + ph),
+                px(top + ph + 5.0)
+            );
+            text(
+                &mut out,
+                sx(t),
+                top + ph + 19.0,
+                12.0,
+                "middle",
+                "",
+                &tick_label(t, xs),
+            );
+        }
+        let (yt, ys) = nice_ticks(by0, by1, 6);
+        for t in yt {
+            let _ = writeln!(
+                out,
+                "<line x1=\"{0}\" y1=\"{1}\" x2=\"{2}\" y2=\"{1}\" stroke=\"#333\"/>",
+                px(left - 5.0),
+                px(sy(t)),
+                px(left)
+            );
+            text(
+                &mut out,
+                left - 8.0,
+                sy(t) + 4.0,
+                12.0,
+                "end",
+                "",
+                &tick_label(t, ys),
+            );
+        }
+        text(
+            &mut out,
+            left + pw / 2.0,
+            top + ph + 38.0,
+            13.0,
+            "middle",
+            "",
+            "x",
+        );
+        text(
+            &mut out,
+            left - 45.0,
+            top + ph / 2.0,
+            13.0,
+            "middle",
+            "",
+            "y",
+        );
         self.colour_bar(&mut out, left + pw + 30.0, top, ph.max(200.0));
         out.push_str("</svg>\n");
         Ok(out)
@@ -808,10 +870,10 @@ mod tests {
         assert_eq!(fixed.colour(100.0), "#fde725", "clamped above the range");
         let svg = m.to_svg().unwrap();
         assert_well_formed(&svg);
-        // 4 x 4 sub-quads per face; the first sub-quad of face 0 has the bilinear value at
-        // its centre (1/8, 1/8): 0.25 of the way... value = u + w = 0.25.
-        assert_eq!(svg.matches("<polygon points").count(), 2 * 16 + 2);
-        assert!(svg.contains(&format!("fill=\"{}\"", m.colour(0.25))));
+        // 8 x 8 sub-quads per face (few faces); the first sub-quad of face 0 has the
+        // bilinear value u + w = 1/16 + 1/16 at its centre.
+        assert_eq!(svg.matches("<polygon points").count(), 2 * 64 + 2);
+        assert!(svg.contains(&format!("fill=\"{}\"", m.colour(0.125))));
         // Colour bar: nice ticks over the range, at the right heights.
         assert_eq!(tick_labels(&svg), vec![0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0]);
         assert_eq!(
