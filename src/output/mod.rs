@@ -1,5 +1,6 @@
 //! Output of a run: VTK frames (`.vtu`), the ParaView time series (`.pvd`), the per-step history
-//! (`.csv`), the end-of-run `summary.json`, and the run's output folder that scripts write below.
+//! (`.csv`), the end-of-run `summary.json`, SVG charts with their data (`svg`), and the run's
+//! output folder that scripts write below.
 //!
 //! Crash safety: every file that is rewritten whole (`.vtu`, `.pvd`, `summary.json`) is written to
 //! a temporary file in the same folder and renamed over the target, so a run stopped at any moment
@@ -10,9 +11,11 @@
 //! round-trips exactly (`{}` or `{:e}`), so parsing them back gives the same `f64`.
 
 mod csv;
+pub mod field_chart;
 mod folder;
 mod pvd;
 mod summary;
+pub mod svg;
 mod vtk;
 
 pub mod run;

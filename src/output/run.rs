@@ -13,6 +13,8 @@ pub struct RunOutput {
     pvd: PvdSeries,
     history: HistoryCsv,
     frames: usize,
+    /// Entries a script added to summary.json (top level, beside the built-in ones).
+    extra: serde_json::Map<String, serde_json::Value>,
 }
 
 impl RunOutput {
@@ -41,6 +43,14 @@ impl RunOutput {
         for c in &sim.model.contacts {
             columns.push(format!("{}_frictional_dissipation", c.tool.name));
         }
+        for c in sim
+            .model
+            .contacts
+            .iter()
+            .filter(|c| c.tool.force_control.is_some())
+        {
+            columns.push(format!("{}_offset", c.tool.name));
+        }
         for name in [
             "tool_work",
             "load_work",
@@ -56,6 +66,7 @@ impl RunOutput {
             pvd,
             history,
             frames: 0,
+            extra: serde_json::Map::new(),
         })
     }
 
@@ -64,7 +75,7 @@ impl RunOutput {
     }
 
     /// Appends the increment's row to history.csv.
-    pub fn record(&mut self, _sim: &Simulation, r: &IncrementReport) -> Result<()> {
+    pub fn record(&mut self, sim: &Simulation, r: &IncrementReport) -> Result<()> {
         let last = r.residuals.last();
         let mut row = vec![
             r.index as f64,
@@ -82,6 +93,11 @@ impl RunOutput {
         }
         let e = &r.energy;
         row.extend_from_slice(&e.frictional_dissipation);
+        for (c, contact) in sim.model.contacts.iter().enumerate() {
+            if contact.tool.force_control.is_some() {
+                row.push(r.tool_offsets[c]);
+            }
+        }
         row.extend_from_slice(&[
             e.tool_work,
             e.load_work,
@@ -100,6 +116,17 @@ impl RunOutput {
         self.pvd.add(sim.time(), &name)?;
         self.frames += 1;
         Ok(())
+    }
+
+    /// Adds (or replaces) a top-level entry of summary.json, written with the next
+    /// [`write_summary`](Self::write_summary); a built-in entry's name is refused there.
+    pub fn set_summary_entry(&mut self, key: &str, value: serde_json::Value) {
+        self.extra.insert(key.to_string(), value);
+    }
+
+    /// Removes a script entry of summary.json.
+    pub fn remove_summary_entry(&mut self, key: &str) {
+        self.extra.remove(key);
     }
 
     /// Writes summary.json; `error` records why a run stopped early.
@@ -125,13 +152,19 @@ impl RunOutput {
                         "work_measure": contact.tool.friction.bernstein().map(|l| l.measure().name()),
                         "frictional_dissipation": sim.energy().frictional_dissipation.get(c),
                         "candidate_nodes": contact.candidates.len(),
+                        "offset": sim.tool_offset(c),
+                        "position": <[f64; 3]>::from(sim.tool_position(c)),
+                        "force_control": contact.tool.force_control.as_ref().map(|fc| serde_json::json!({
+                            "axis": [fc.axis.x, fc.axis.y, fc.axis.z],
+                            "scheduled_force": fc.force.value(sim.time()),
+                        })),
                     }),
                 )
             })
             .collect();
         let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();
         let settings = &sim.model.settings;
-        let summary = serde_json::json!({
+        let mut summary = serde_json::json!({
             "status": if error.is_some() { "stopped" } else if sim.is_finished() { "finished" } else { "running" },
             "error": error,
             "time": sim.time(),
@@ -158,6 +191,16 @@ impl RunOutput {
             "tools": tools,
             "frames": self.frames,
         });
+        if let Some(map) = summary.as_object_mut() {
+            for (key, value) in &self.extra {
+                if map.contains_key(key) {
+                    return Err(crate::Error::Input(format!(
+                        "summary entry '{key}' is written by the engine; choose another name"
+                    )));
+                }
+                map.insert(key.clone(), value.clone());
+            }
+        }
         write_summary(&self.folder.resolve_for_write("summary.json")?, &summary)
     }
 }

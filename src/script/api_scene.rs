@@ -393,6 +393,20 @@ fn register_tools(engine: &mut Engine) {
             Ok(t.clone())
         },
     );
+    // tool.force_control([ax, ay, az], force): the tool's offset along the axis becomes an
+    // unknown fixed by the force it applies to the body along the axis (a number or
+    // [[t, F], ...]).
+    engine.register_fn(
+        "force_control",
+        |t: &mut Tool, axis: Array, force: Dynamic| -> ScriptResult<Tool> {
+            let axis = vec3(&axis, &format!("force-control axis of tool '{}'", t.name))?;
+            t.force_control = Some(lift(crate::tool::ForceControl::new(
+                axis,
+                scalar_schedule(&force)?,
+            ))?);
+            Ok(t.clone())
+        },
+    );
     engine.register_fn("friction", |t: &mut Tool, law: FrictionLaw| -> Tool {
         t.friction = law;
         t.clone()

@@ -23,6 +23,8 @@ pub struct SimState {
     output_every: usize,
     host: Rc<HostOptions>,
     started: Option<Instant>,
+    /// Wall time of the run, fixed when it finished (post-processing does not count).
+    wall_time: Option<f64>,
     /// Per converged increment: (index, time, per tool, per candidate [work, mu, status]).
     node_log: Vec<NodeSnapshot>,
 }
@@ -116,6 +118,34 @@ impl SimState {
         }
     }
 
+    fn elapsed(&self) -> f64 {
+        self.wall_time.unwrap_or_else(|| {
+            self.started
+                .map(|s| s.elapsed().as_secs_f64())
+                .unwrap_or(0.0)
+        })
+    }
+
+    /// Adds a top-level entry to summary.json and rewrites it at once (so that an entry
+    /// added after `sim.run()` lands in the file, and a name clash is reported here).
+    pub(super) fn add_summary_entry(
+        &mut self,
+        key: &str,
+        value: serde_json::Value,
+    ) -> ScriptResult<()> {
+        self.simulation()?;
+        let wall = self.elapsed();
+        let (Some(out), Some(sim)) = (self.output.as_mut(), self.sim.as_ref()) else {
+            return runtime_error("output is off for this simulation (settings output_every = 0)");
+        };
+        out.set_summary_entry(key, value);
+        let result = out.write_summary(sim, wall, None);
+        if result.is_err() {
+            out.remove_summary_entry(key);
+        }
+        lift(result)
+    }
+
     /// Writes the increment's outputs and keeps each contact node's history.
     fn record_step(&mut self, report: &IncrementReport) -> ScriptResult<()> {
         let every = self.output_every;
@@ -139,10 +169,8 @@ impl SimState {
     }
 
     fn finish(&mut self) -> ScriptResult<()> {
-        let wall = self
-            .started
-            .map(|s| s.elapsed().as_secs_f64())
-            .unwrap_or(0.0);
+        let wall = self.elapsed();
+        self.wall_time = Some(wall);
         if let (Some(out), Some(sim)) = (self.output.as_mut(), self.sim.as_ref()) {
             lift(out.write_summary(sim, wall, None))?;
         }
@@ -175,6 +203,12 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
         );
     }
     m.insert("tool_forces".into(), Dynamic::from(forces));
+    let offsets: Map = tools
+        .iter()
+        .zip(&r.tool_offsets)
+        .map(|(name, s)| (name.into(), Dynamic::from(*s)))
+        .collect();
+    m.insert("tool_offsets".into(), Dynamic::from(offsets));
     m
 }
 
@@ -276,6 +310,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 output_every: 1,
                 host: h.clone(),
                 started: None,
+                wall_time: None,
                 node_log: Vec::new(),
             })))
         },
@@ -420,6 +455,26 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             let sim = st.simulation()?;
             let c = lift(sim.model.tool_index(name))?;
             Ok(array3(&sim.tool_force(c)))
+        },
+    );
+    // Offset of a force-controlled tool along its axis (0 for a kinematic tool).
+    engine.register_fn(
+        "tool_offset",
+        |s: &mut ScriptSim, name: &str| -> ScriptResult<f64> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let c = lift(sim.model.tool_index(name))?;
+            Ok(sim.tool_offset(c))
+        },
+    );
+    // Translation of a tool now: its schedule plus any force-control offset.
+    engine.register_fn(
+        "tool_position",
+        |s: &mut ScriptSim, name: &str| -> ScriptResult<Array> {
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let c = lift(sim.model.tool_index(name))?;
+            Ok(array3(&sim.tool_position(c)))
         },
     );
     engine.register_fn(

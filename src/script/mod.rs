@@ -4,6 +4,7 @@
 //! below this module knows that Rhai exists. Scripts run sandboxed: operation, call-depth
 //! and size limits, and output only below the run's output folder.
 
+mod api_charts;
 mod api_scene;
 mod api_sim;
 mod api_tools;
@@ -59,7 +60,8 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     let host = Rc::new(host.clone());
     api_scene::register(&mut engine, host.clone());
     api_tools::register(&mut engine, script_dir);
-    api_sim::register(&mut engine, host);
+    api_sim::register(&mut engine, host.clone());
+    api_charts::register(&mut engine, host);
     register_checks(&mut engine);
     engine
 }

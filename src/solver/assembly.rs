@@ -12,6 +12,7 @@
 //! starts, so their update is zero). Cost per iteration: O(elements * 24^2 + pairs * 9)
 //! for the values, plus one projection per pair.
 
+use super::force_control;
 use super::model::Model;
 use super::sparse::{SparseMatrix, SparsePattern};
 use crate::contact::{
@@ -32,6 +33,9 @@ pub struct DofMap {
     pub n_nodes: usize,
     /// First multiplier dof of each contact (tool) block, or None under penalty.
     pub lambda_offset: Vec<Option<usize>>,
+    /// Offset unknown of each force-controlled tool (after all multipliers), see
+    /// `force_control`.
+    pub tool_offset: Vec<Option<usize>>,
     pub n_dofs: usize,
 }
 
@@ -50,10 +54,12 @@ impl DofMap {
                 }
                 Enforcement::Penalty => None,
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let tool_offset = force_control::allocate(model, &lambda_offset, &mut next);
         DofMap {
             n_nodes,
             lambda_offset,
+            tool_offset,
             n_dofs: next,
         }
     }
@@ -86,6 +92,7 @@ impl DofMap {
                 }
             }
         }
+        force_control::pattern_entries(model, self, &mut entries);
         for d in 0..self.n_dofs {
             entries.push((d, d));
         }
@@ -191,7 +198,7 @@ impl IncrementContext<'_> {
         let mut unit_rows: Vec<(usize, f64)> = Vec::new();
         let mut nodal = Vec::with_capacity(model.contacts.len());
         for (c, contact) in model.contacts.iter().enumerate() {
-            let pose = &self.poses[c];
+            let pose = &force_control::shifted(&self.poses[c], model, self.dofs, c, x);
             let mut list = Vec::with_capacity(contact.candidates.len());
             for (k, &node) in contact.candidates.iter().enumerate() {
                 let committed = &self.committed_contact[c][k];
@@ -271,11 +278,21 @@ impl IncrementContext<'_> {
                             jac.add(l + i, l + j, result.suppl_lambda[(i, j)]);
                         }
                     }
+                    force_control::add_node_column(&mut jac, model, self.dofs, c, node, l, &result);
                 }
                 list.push((result, proj));
             }
             nodal.push(list);
         }
+        force_control::add_force_rows(
+            model,
+            self.dofs,
+            self.time,
+            x,
+            &nodal,
+            &mut residual,
+            &mut jac,
+        )?;
         times.contact += t1.elapsed().as_secs_f64();
 
         let support_forces: Vec<f64> = (0..3 * self.dofs.n_nodes)

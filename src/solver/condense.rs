@@ -20,7 +20,7 @@
 //! and the row is plain equilibrium; in stick M = 0 and it is the kinematic constraint.)
 //! The reduced system has the displacement unknowns plus the multipliers that stay: pairs
 //! at nodes with a prescribed component or with several pairs (a node that two tools may
-//! touch). Cost: O(nnz) per iteration to build; the factorization shrinks by the number of
+//! touch), and all pairs of a force-controlled tool (its force row couples them). Cost: O(nnz) per iteration to build; the factorization shrinks by the number of
 //! eliminated multipliers.
 
 use super::assembly::DofMap;
@@ -72,7 +72,8 @@ impl Condenser {
         }
         let mut eliminated = Vec::new();
         for (c, contact) in model.contacts.iter().enumerate() {
-            let Some(off) = dofs.lambda_offset[c] else {
+            // A force-controlled tool's row couples all its multipliers: they stay.
+            let Some(off) = dofs.lambda_offset[c].filter(|_| dofs.tool_offset[c].is_none()) else {
                 continue;
             };
             for (k, &node) in contact.candidates.iter().enumerate() {

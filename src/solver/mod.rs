@@ -2,6 +2,7 @@
 
 pub mod assembly;
 pub mod condense;
+pub mod force_control;
 pub mod linear;
 pub mod model;
 pub mod simulation;

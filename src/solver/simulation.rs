@@ -5,6 +5,7 @@
 
 use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
 use super::condense::Condenser;
+use super::force_control;
 use super::linear::{FaerLu, LinearSolver};
 use super::model::Model;
 use super::sparse::SparsePattern;
@@ -41,6 +42,8 @@ pub struct IncrementReport {
     pub cutbacks: usize,
     /// Total force on each tool (force the body exerts on the tool), in tool order.
     pub tool_forces: Vec<[f64; 3]>,
+    /// Offset of each tool along its force-control axis (0 for kinematic tools).
+    pub tool_offsets: Vec<f64>,
     pub active_nodes: usize,
     pub slipping_nodes: usize,
     /// Energy balance after this increment.
@@ -81,6 +84,7 @@ impl Simulation {
                 "must be > 0",
             ));
         }
+        force_control::check(&model)?;
         let dofs = DofMap::new(&model);
         let pattern = Arc::new(dofs.pattern(&model));
         let mut is_fixed = vec![false; dofs.n_dofs];
@@ -177,6 +181,17 @@ impl Simulation {
     /// Committed contact states of tool `c`, in the order of its candidate nodes.
     pub fn contact_states(&self, c: usize) -> &[ContactNodeState] {
         &self.contact[c]
+    }
+
+    /// Offset of tool `c` along its force-control axis at the committed state (0 for a
+    /// kinematic tool).
+    pub fn tool_offset(&self, c: usize) -> f64 {
+        force_control::offset(&self.dofs, c, &self.x)
+    }
+
+    /// Translation of tool `c` at the committed state (schedule plus force-control offset).
+    pub fn tool_position(&self, c: usize) -> Vec3 {
+        force_control::pose(&self.model, &self.dofs, c, self.time, &self.x).translation
     }
 
     /// Total force on tool `c` at the committed state (sum of multipliers).
@@ -418,7 +433,7 @@ impl Simulation {
             .iter()
             .enumerate()
             .map(|(c, contact)| {
-                let pose = contact.tool.pose(t_new);
+                let pose = force_control::pose(&self.model, &self.dofs, c, t_new, &self.x);
                 contact
                     .candidates
                     .iter()
@@ -451,7 +466,7 @@ impl Simulation {
         let mut dissipated = vec![0.0; self.model.contacts.len()];
         let (mut active, mut slipping) = (0, 0);
         for (c, contact) in self.model.contacts.iter().enumerate() {
-            let pose = contact.tool.pose(t_new);
+            let pose = force_control::pose(&self.model, &self.dofs, c, t_new, &x);
             let mut total = Vec3::zeros();
             for (k, &node) in contact.candidates.iter().enumerate() {
                 let (res, proj) = &eval.nodal[c][k];
@@ -505,6 +520,9 @@ impl Simulation {
             tool_forces.push([total.x, total.y, total.z]);
         }
         let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated);
+        let tool_offsets = (0..self.model.contacts.len())
+            .map(|c| force_control::offset(&self.dofs, c, &x))
+            .collect();
         self.x = x;
         self.points = eval.trial_points;
         let dt = t_new - self.time;
@@ -518,6 +536,7 @@ impl Simulation {
             residuals,
             cutbacks: 0,
             tool_forces,
+            tool_offsets,
             active_nodes: active,
             slipping_nodes: slipping,
             energy,
@@ -543,9 +562,9 @@ impl Simulation {
             e.support_work += 0.5 * (last.support_forces[d] + eval.support_forces[d]) * du;
             e.load_work += 0.5 * (last.external_forces[d] + eval.f_ext[d]) * du;
         }
-        for (c, contact) in self.model.contacts.iter().enumerate() {
-            let travel = contact.tool.schedule.translation(t_new)
-                - contact.tool.schedule.translation(self.time);
+        for c in 0..self.model.contacts.len() {
+            let travel = force_control::pose(&self.model, &self.dofs, c, t_new, x).translation
+                - force_control::pose(&self.model, &self.dofs, c, self.time, &self.x).translation;
             let force = Vec3::from(tool_forces[c]);
             // The body pushes the tool with +lambda, the tool the body with -lambda.
             e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);

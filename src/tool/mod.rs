@@ -1,5 +1,6 @@
 //! Rigid tools: a surface, its pose, and how the pose moves with pseudo-time (see DESIGN.md).
 
+pub mod force_control;
 pub mod pose;
 pub mod schedule;
 
@@ -7,4 +8,5 @@ pub use pose::{project_posed, Pose};
 pub use schedule::{ScalarSchedule, Schedule};
 pub mod rigid_tool;
 
+pub use force_control::ForceControl;
 pub use rigid_tool::Tool;

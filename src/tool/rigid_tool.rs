@@ -1,5 +1,6 @@
 //! A rigid tool: a surface, where it is at each time, and its friction law.
 
+use super::force_control::ForceControl;
 use super::pose::{project_posed, Pose};
 use super::schedule::Schedule;
 use crate::contact::FrictionLaw;
@@ -13,6 +14,8 @@ pub struct Tool {
     pub surface: Arc<dyn RigidSurface>,
     pub schedule: Schedule,
     pub friction: FrictionLaw,
+    /// When set, the tool's position along an axis is an unknown fixed by a force schedule.
+    pub force_control: Option<ForceControl>,
 }
 
 impl Tool {
@@ -22,10 +25,11 @@ impl Tool {
             surface,
             schedule: Schedule::fixed(),
             friction: FrictionLaw::frictionless(),
+            force_control: None,
         }
     }
 
-    /// The tool's pose at (pseudo-)time `t`.
+    /// The tool's scheduled pose at (pseudo-)time `t` (without a force-control offset).
     pub fn pose(&self, t: f64) -> Pose {
         self.schedule.pose(t)
     }

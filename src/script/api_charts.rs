@@ -1,0 +1,199 @@
+//! Charts and summary entries for scripts: `line_chart(file, spec)`,
+//! `sim.chart_field(file, face_set, field, options)` and `sim.summary(key, value)`.
+//! Chart files go below the run's output folder (relative paths only, no `..`), each with a
+//! CSV of its data beside it.
+
+use super::api_sim::ScriptSim;
+use super::convert::*;
+use super::HostOptions;
+use crate::output::field_chart::{field_map, Configuration};
+use crate::output::svg::{LineChart, Series};
+use crate::output::OutputFolder;
+use rhai::{Array, Dynamic, Engine, Map};
+use std::path::PathBuf;
+use std::rc::Rc;
+
+/// `file` below the output folder, ending in .svg, parent folders created.
+fn chart_path(host: &HostOptions, file: &str) -> ScriptResult<PathBuf> {
+    if !file.ends_with(".svg") {
+        return runtime_error(format!("chart file \"{file}\" must end in .svg"));
+    }
+    lift(OutputFolder::create(&host.out_dir).and_then(|f| f.resolve_for_write(file)))
+}
+
+fn string(v: &Dynamic, what: &str) -> ScriptResult<String> {
+    v.clone()
+        .into_string()
+        .map_err(|t| format!("{what} must be a string, got {t}"))
+        .or_else(runtime_error)
+}
+
+fn numbers(v: &Dynamic, what: &str) -> ScriptResult<Vec<f64>> {
+    let a = v
+        .clone()
+        .try_cast::<Array>()
+        .ok_or_else(|| format!("{what} must be an array of numbers, got {}", v.type_name()))
+        .or_else(runtime_error)?;
+    a.iter()
+        .enumerate()
+        .map(|(i, x)| number(x, &format!("{what}[{i}]")))
+        .collect()
+}
+
+fn line_chart_spec(spec: &Map) -> ScriptResult<LineChart> {
+    let mut chart = LineChart::default();
+    for (key, v) in spec {
+        match key.as_str() {
+            "title" => chart.title = string(v, "line chart title")?,
+            "x_label" => chart.x_label = string(v, "x_label")?,
+            "y_label" => chart.y_label = string(v, "y_label")?,
+            "series" => {
+                let list = v
+                    .clone()
+                    .try_cast::<Array>()
+                    .ok_or_else(|| "series must be an array of #{ name, x, y } maps".to_string())
+                    .or_else(runtime_error)?;
+                for (i, s) in list.iter().enumerate() {
+                    let m = s
+                        .clone()
+                        .try_cast::<Map>()
+                        .ok_or_else(|| format!("series[{i}] must be a map #{{ name, x, y }}"))
+                        .or_else(runtime_error)?;
+                    let get = |k: &str| {
+                        m.get(k)
+                            .ok_or_else(|| format!("series[{i}] has no '{k}'"))
+                            .or_else(runtime_error)
+                    };
+                    if let Some(k) = m.keys().find(|k| !["name", "x", "y"].contains(&k.as_str())) {
+                        return runtime_error(format!(
+                            "series[{i}]: unknown key '{k}' (known: name, x, y)"
+                        ));
+                    }
+                    chart.series.push(Series {
+                        name: string(get("name")?, &format!("series[{i}].name"))?,
+                        x: numbers(get("x")?, &format!("series[{i}].x"))?,
+                        y: numbers(get("y")?, &format!("series[{i}].y"))?,
+                    });
+                }
+            }
+            other => {
+                return runtime_error(format!(
+                    "unknown line chart key '{other}' (known: title, x_label, y_label, series)"
+                ))
+            }
+        }
+    }
+    Ok(chart)
+}
+
+/// A Rhai value as JSON; `at` names the place in the value for errors.
+fn to_json(v: &Dynamic, at: &str) -> ScriptResult<serde_json::Value> {
+    use serde_json::Value;
+    if v.is_unit() {
+        Ok(Value::Null)
+    } else if let Ok(b) = v.as_bool() {
+        Ok(Value::Bool(b))
+    } else if let Ok(i) = v.as_int() {
+        Ok(Value::from(i))
+    } else if let Ok(f) = v.as_float() {
+        // JSON has no NaN or infinity: they become null, as in the engine's summary.
+        Ok(Value::from(f))
+    } else if v.is_string() || v.is_char() {
+        Ok(Value::String(v.to_string()))
+    } else if let Some(a) = v.clone().try_cast::<Array>() {
+        a.iter()
+            .enumerate()
+            .map(|(i, x)| to_json(x, &format!("{at}[{i}]")))
+            .collect::<ScriptResult<Vec<_>>>()
+            .map(Value::Array)
+    } else if let Some(m) = v.clone().try_cast::<Map>() {
+        let mut out = serde_json::Map::new();
+        for (k, x) in &m {
+            out.insert(k.to_string(), to_json(x, &format!("{at}.{k}"))?);
+        }
+        Ok(Value::Object(out))
+    } else {
+        runtime_error(format!(
+            "summary value {at} is a {} which has no JSON form (use numbers, strings, booleans, arrays, maps)",
+            v.type_name()
+        ))
+    }
+}
+
+pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
+    let h = host.clone();
+    engine.register_fn(
+        "line_chart",
+        move |file: &str, spec: Map| -> ScriptResult<()> {
+            let chart = line_chart_spec(&spec)?;
+            lift(chart.write(&chart_path(&h, file)?).map(|_| ()))
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "chart_field",
+        move |s: &mut ScriptSim, file: &str, face_set: &str, field: &str, options: Map| -> ScriptResult<()> {
+            let mut configuration = Configuration::Current;
+            let (mut title, mut label, mut range) = (None, None, None);
+            for (key, v) in &options {
+                match key.as_str() {
+                    "title" => title = Some(string(v, "chart title")?),
+                    "label" => label = Some(string(v, "colour bar label")?),
+                    "configuration" => {
+                        configuration = lift(Configuration::parse(&string(v, "configuration")?))?
+                    }
+                    "range" => {
+                        let r = numbers(v, "range")?;
+                        if r.len() != 2 {
+                            return runtime_error(format!("range must be [low, high], got {} numbers", r.len()));
+                        }
+                        range = Some((r[0], r[1]));
+                    }
+                    other => {
+                        return runtime_error(format!(
+                            "unknown chart_field option '{other}' (known: title, label, range, configuration)"
+                        ))
+                    }
+                }
+            }
+            let path = chart_path(&h, file)?;
+            let mut st = s.borrow_mut();
+            let sim = st.simulation()?;
+            let mut map = lift(field_map(sim, face_set, field, configuration))?;
+            map.title = title.unwrap_or(map.title);
+            map.label = label.unwrap_or(map.label);
+            map.range = range;
+            lift(map.write(&path).map(|_| ()))
+        },
+    );
+    engine.register_fn(
+        "chart_field",
+        |ctx: rhai::NativeCallContext,
+         s: &mut ScriptSim,
+         file: &str,
+         face_set: &str,
+         field: &str|
+         -> ScriptResult<()> {
+            ctx.call_native_fn(
+                "chart_field",
+                (
+                    s.clone(),
+                    file.to_string(),
+                    face_set.to_string(),
+                    field.to_string(),
+                    Map::new(),
+                ),
+            )
+        },
+    );
+    engine.register_fn(
+        "summary",
+        |s: &mut ScriptSim, key: &str, value: Dynamic| -> ScriptResult<()> {
+            if key.is_empty() {
+                return runtime_error("a summary entry needs a non-empty name");
+            }
+            let json = to_json(&value, key)?;
+            s.borrow_mut().add_summary_entry(key, json)
+        },
+    );
+}

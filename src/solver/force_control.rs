@@ -1,0 +1,194 @@
+//! Force control of tools: for each force-controlled tool one scalar unknown `s` (the
+//! tool's offset along its unit axis `a`) is appended to the unknown vector after the
+//! displacements and multipliers, and one equation fixes the tool's force.
+//!
+//! Pose: `T(t, s) = T_sched(t) + s a`. Every quantity of a contact node against the tool
+//! (projection, gap, slip reference `x_ref = T + x_ref_local`) depends on the node position
+//! `x` only through `x - T`, so the derivatives with respect to `s` are exact copies of the
+//! position derivatives:
+//!
+//! ```text
+//! d F_equi  / ds = -(dF_equi/dx) a,      d F_suppl / ds = -(dF_suppl/dx) a
+//! ```
+//!
+//! Equation of the tool (the force the tool applies to the body along `a` equals the
+//! schedule; the body pushes the tool with `+lambda`, see `Simulation::tool_force`):
+//!
+//! ```text
+//! R_s = ( -a . sum_k lambda_k - F(t) ) / r_s,     dR_s/dlambda_k = -a^T / r_s
+//! ```
+//!
+//! The multipliers rather than the `F_equi` are summed: both agree at convergence
+//! (`F_suppl = 0`) and the multipliers make the row linear. Dividing by `r_s`, the mean
+//! augmentation parameter of the tool's nodes, makes `R_s` a length like the other
+//! multiplier rows, so the Newton contact tolerance covers it: at convergence the force
+//! error is at most `r_s * contact_tol`.
+//!
+//! A tool touching no node leaves `s` undetermined (the column of `s` is zero). Then the
+//! row is replaced by the approach equation `s - s_now = min_k d_k / (n_k . a)`: one Newton
+//! step brings the tool into touch with the nearest node along its axis, which then counts
+//! as sticking with zero multiplier (the operator's boundary rule) and the force equation
+//! takes over. If no node lies ahead along the axis the solve stops with an error naming
+//! the tool.
+//!
+//! The multipliers of a force-controlled tool are not condensed out (see `condense`): the
+//! row `R_s` couples them all.
+
+use super::assembly::DofMap;
+use super::model::Model;
+use super::sparse::SparseMatrix;
+use crate::contact::{Enforcement, NodalContact};
+use crate::geometry::{Projection, Vec3};
+use crate::tool::Pose;
+use crate::{Error, Result};
+
+/// Refuses force control where it cannot work (penalty has no multiplier unknowns).
+pub fn check(model: &Model) -> Result<()> {
+    for c in &model.contacts {
+        if c.tool.force_control.is_some()
+            && model.settings.contact.enforcement == Enforcement::Penalty
+        {
+            return Err(Error::Input(format!(
+                "tool '{}' is force-controlled, which needs the augmented Lagrangian enforcement (not penalty)",
+                c.tool.name
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Allocates the offset unknowns after `next`: one per force-controlled tool that has
+/// multipliers.
+pub fn allocate(
+    model: &Model,
+    lambda_offset: &[Option<usize>],
+    next: &mut usize,
+) -> Vec<Option<usize>> {
+    model
+        .contacts
+        .iter()
+        .zip(lambda_offset)
+        .map(|(c, l)| match (&c.tool.force_control, l) {
+            (Some(_), Some(_)) => {
+                *next += 1;
+                Some(*next - 1)
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// The offset `s` of tool `c` in the unknowns `x` (0 for a kinematic tool).
+pub fn offset(dofs: &DofMap, c: usize, x: &[f64]) -> f64 {
+    dofs.tool_offset[c].map_or(0.0, |d| x[d])
+}
+
+/// `scheduled` moved by the offset of tool `c` in `x`.
+pub fn shifted(scheduled: &Pose, model: &Model, dofs: &DofMap, c: usize, x: &[f64]) -> Pose {
+    match &model.contacts[c].tool.force_control {
+        Some(fc) => Pose::from_translation(scheduled.translation + fc.axis * offset(dofs, c, x)),
+        None => *scheduled,
+    }
+}
+
+/// The pose of tool `c` at time `t` for the unknowns `x`.
+pub fn pose(model: &Model, dofs: &DofMap, c: usize, t: f64, x: &[f64]) -> Pose {
+    shifted(&model.contacts[c].tool.pose(t), model, dofs, c, x)
+}
+
+/// Sparsity entries of the offset unknowns: the column (equilibrium and multiplier rows of
+/// every candidate) and the row (every multiplier); the diagonal is added by the caller.
+pub fn pattern_entries(model: &Model, dofs: &DofMap, entries: &mut Vec<(usize, usize)>) {
+    for (c, contact) in model.contacts.iter().enumerate() {
+        let (Some(s), Some(off)) = (dofs.tool_offset[c], dofs.lambda_offset[c]) else {
+            continue;
+        };
+        for (k, &node) in contact.candidates.iter().enumerate() {
+            let l = off + 3 * k;
+            for i in 0..3 {
+                entries.push((3 * node + i, s));
+                entries.push((l + i, s));
+                entries.push((s, l + i));
+            }
+        }
+    }
+}
+
+/// Adds the `s` column of one candidate node (node `node`, multiplier block at `l`).
+pub fn add_node_column(
+    jac: &mut SparseMatrix,
+    model: &Model,
+    dofs: &DofMap,
+    c: usize,
+    node: usize,
+    l: usize,
+    result: &NodalContact,
+) {
+    let (Some(s), Some(fc)) = (dofs.tool_offset[c], &model.contacts[c].tool.force_control) else {
+        return;
+    };
+    let equi = -(result.equi_x * fc.axis);
+    let suppl = -(result.suppl_x * fc.axis);
+    for i in 0..3 {
+        jac.add(3 * node + i, s, equi[i]);
+        jac.add(l + i, s, suppl[i]);
+    }
+}
+
+/// Mean augmentation parameter of tool `c`: the scale of its force row.
+fn row_scale(model: &Model, c: usize) -> f64 {
+    let r = &model.contacts[c].r;
+    r.iter().sum::<f64>() / r.len().max(1) as f64
+}
+
+/// Adds the force equation of every force-controlled tool (or its approach equation when
+/// the tool touches nothing) at time `time`. `nodal` is the evaluation's per-node output.
+pub fn add_force_rows(
+    model: &Model,
+    dofs: &DofMap,
+    time: f64,
+    x: &[f64],
+    nodal: &[Vec<(NodalContact, Option<Projection>)>],
+    residual: &mut [f64],
+    jac: &mut SparseMatrix,
+) -> Result<()> {
+    for (c, contact) in model.contacts.iter().enumerate() {
+        let (Some(s), Some(off), Some(fc)) = (
+            dofs.tool_offset[c],
+            dofs.lambda_offset[c],
+            &contact.tool.force_control,
+        ) else {
+            continue;
+        };
+        if nodal[c].iter().any(|(r, _)| r.status.is_active()) {
+            let r_s = row_scale(model, c);
+            let mut pushed = 0.0;
+            for k in 0..contact.candidates.len() {
+                let l = off + 3 * k;
+                let lambda = Vec3::new(x[l], x[l + 1], x[l + 2]);
+                pushed -= fc.axis.dot(&lambda);
+                for j in 0..3 {
+                    jac.add(s, l + j, -fc.axis[j] / r_s);
+                }
+            }
+            residual[s] = (pushed - fc.force.value(time)) / r_s;
+        } else {
+            // Approach: the smallest travel along the axis that closes a gap.
+            let travel = nodal[c]
+                .iter()
+                .filter_map(|(_, p)| p.as_ref())
+                .filter(|p| p.normal.dot(&fc.axis) > 1e-3)
+                .map(|p| p.gap / p.normal.dot(&fc.axis))
+                .min_by(f64::total_cmp)
+                .ok_or_else(|| {
+                    Error::NoConvergence(format!(
+                        "force-controlled tool '{}' touches no node and no node lies ahead of it along its axis [{}, {}, {}]: its position is undetermined",
+                        contact.tool.name, fc.axis.x, fc.axis.y, fc.axis.z
+                    ))
+                })?;
+            residual[s] = -travel;
+            jac.add(s, s, 1.0);
+        }
+    }
+    Ok(())
+}
