@@ -304,7 +304,7 @@ pub(super) fn nodes_array(what: &str, v: &[Vec3]) -> Result<[Vec3; NODES]> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use nalgebra::{DMatrix, DVector};
 
     use super::*;
@@ -313,16 +313,16 @@ mod tests {
     use crate::mesh::Mesh;
 
     /// A cheap deterministic pseudo-random sequence in [-1, 1) (no dev-dependencies).
-    struct Lcg(u64);
+    pub(crate) struct Lcg(pub(crate) u64);
     impl Lcg {
-        fn next(&mut self) -> f64 {
+        pub(crate) fn next(&mut self) -> f64 {
             self.0 = self
                 .0
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         }
-        fn vec(&mut self) -> Vec3 {
+        pub(crate) fn vec(&mut self) -> Vec3 {
             Vec3::new(self.next(), self.next(), self.next())
         }
     }
@@ -365,7 +365,7 @@ mod tests {
 
     /// A unit cube with every node moved by up to 0.15 in each direction: far from a
     /// parallelepiped, still a valid element.
-    fn distorted_element() -> [Vec3; 8] {
+    pub(crate) fn distorted_element() -> [Vec3; 8] {
         let mut rng = Lcg(7);
         let x: [Vec3; 8] = std::array::from_fn(|a| {
             let c = HEX_CORNERS[a];
