@@ -100,20 +100,20 @@ pub fn jacobian(x: &[Vec3; NODES], xi: &Vec3) -> Mat3 {
 }
 
 /// Reference-configuration geometry of one element at its integration points.
-struct Geometry {
+pub(super) struct Geometry {
     /// Spatial gradients `∇N_a` at each integration point, `grad[g][a]`.
-    grad: [[Vec3; NODES]; POINTS],
+    pub(super) grad: [[Vec3; NODES]; POINTS],
     /// Volume weights `w_g det J_g` (the weights are 1).
-    dvol: [f64; POINTS],
+    pub(super) dvol: [f64; POINTS],
     /// Element volume `Σ_g dvol[g]`.
-    volume: f64,
+    pub(super) volume: f64,
     /// Volume-averaged gradients `b̄_a = (1/V) Σ_g ∇N_a(g) dvol[g]`.
     mean_grad: [Vec3; NODES],
 }
 
 impl Geometry {
     /// Errors if `det J` is not positive (or not finite) at an integration point.
-    fn new(x: &[Vec3; NODES]) -> Result<Geometry> {
+    pub(super) fn new(x: &[Vec3; NODES]) -> Result<Geometry> {
         let mut grad = [[Vec3::zeros(); NODES]; POINTS];
         let mut dvol = [0.0; POINTS];
         for (g, xi) in integration_points().iter().enumerate() {
@@ -254,6 +254,12 @@ impl Element<DOFS> for Hex8 {
         Ok(Geometry::new(&nodes_array("ref_coords", ref_coords)?)?.volume)
     }
 
+    fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>> {
+        Ok(Geometry::new(&nodes_array("ref_coords", ref_coords)?)?
+            .dvol
+            .to_vec())
+    }
+
     fn average_stress(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<Voigt> {
         check_len("states", states.len(), POINTS)?;
         let geo = Geometry::new(&nodes_array("ref_coords", ref_coords)?)?;
@@ -281,7 +287,7 @@ impl Element<DOFS> for Hex8 {
     }
 }
 
-fn check_len(what: &str, len: usize, expected: usize) -> Result<()> {
+pub(super) fn check_len(what: &str, len: usize, expected: usize) -> Result<()> {
     if len != expected {
         return Err(Error::input(
             &format!("length of {what}"),
@@ -292,13 +298,13 @@ fn check_len(what: &str, len: usize, expected: usize) -> Result<()> {
     Ok(())
 }
 
-fn nodes_array(what: &str, v: &[Vec3]) -> Result<[Vec3; NODES]> {
+pub(super) fn nodes_array(what: &str, v: &[Vec3]) -> Result<[Vec3; NODES]> {
     check_len(what, v.len(), NODES)?;
     Ok(std::array::from_fn(|a| v[a]))
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use nalgebra::{DMatrix, DVector};
 
     use super::*;
@@ -307,16 +313,16 @@ mod tests {
     use crate::mesh::Mesh;
 
     /// A cheap deterministic pseudo-random sequence in [-1, 1) (no dev-dependencies).
-    struct Lcg(u64);
+    pub(crate) struct Lcg(pub(crate) u64);
     impl Lcg {
-        fn next(&mut self) -> f64 {
+        pub(crate) fn next(&mut self) -> f64 {
             self.0 = self
                 .0
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         }
-        fn vec(&mut self) -> Vec3 {
+        pub(crate) fn vec(&mut self) -> Vec3 {
             Vec3::new(self.next(), self.next(), self.next())
         }
     }
@@ -359,7 +365,7 @@ mod tests {
 
     /// A unit cube with every node moved by up to 0.15 in each direction: far from a
     /// parallelepiped, still a valid element.
-    fn distorted_element() -> [Vec3; 8] {
+    pub(crate) fn distorted_element() -> [Vec3; 8] {
         let mut rng = Lcg(7);
         let x: [Vec3; 8] = std::array::from_fn(|a| {
             let c = HEX_CORNERS[a];

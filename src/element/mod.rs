@@ -1,5 +1,6 @@
-//! Finite elements: the [`Element`] interface and the 8-node hexahedron [`Hex8`] with
-//! selective reduced integration (B-bar).
+//! Finite elements: the [`Element`] interface, the 8-node hexahedron [`Hex8`] with
+//! selective reduced integration (B-bar, small strain) and its finite-strain counterpart
+//! [`Hex8FBar`] (total Lagrangian, F-bar). [`StrainTheory`] picks one for a model.
 //!
 //! An element maps nodal displacements to the internal force vector and its tangent
 //!
@@ -18,8 +19,55 @@ use crate::mesh::Mesh;
 use crate::{Error, Result};
 
 pub mod hex8;
+pub mod hex8_fbar;
 
 pub use hex8::Hex8;
+pub use hex8_fbar::Hex8FBar;
+
+/// Kinematics of a model: which hexahedron the solver uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StrainTheory {
+    /// Small strain and rotation: [`Hex8`] (B-bar), the material's small-strain
+    /// [`Material::update`]. The default, so that models written for linear theory keep it.
+    #[default]
+    Small,
+    /// Large strain and rotation: [`Hex8FBar`] (total Lagrangian, F-bar), the material's
+    /// [`Material::update_finite`] (Lagrangian logarithmic strain).
+    Finite,
+}
+
+impl StrainTheory {
+    /// The script name: "small" or "finite".
+    pub fn name(self) -> &'static str {
+        match self {
+            StrainTheory::Small => "small",
+            StrainTheory::Finite => "finite",
+        }
+    }
+
+    /// From the script name; errors name the value and the choices.
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "small" => Ok(StrainTheory::Small),
+            "finite" => Ok(StrainTheory::Finite),
+            other => Err(Error::input(
+                "kinematics",
+                format!("\"{other}\""),
+                "must be \"small\" or \"finite\"",
+            )),
+        }
+    }
+}
+
+/// The hexahedron of a strain theory (both have the 2x2x2 points in the same order).
+pub fn hexahedron(theory: StrainTheory) -> &'static dyn Element<{ hex8::DOFS }> {
+    static SMALL: Hex8 = Hex8;
+    static FINITE: Hex8FBar = Hex8FBar { fbar: true };
+    match theory {
+        StrainTheory::Small => &SMALL,
+        StrainTheory::Finite => &FINITE,
+    }
+}
 
 /// Internal force and tangent stiffness of one element with `D` degrees of freedom
 /// (`D = 3 x nodes`).
@@ -65,6 +113,26 @@ pub trait Element<const D: usize>: std::fmt::Debug + Send + Sync {
 
     /// Volume of the element (reference configuration).
     fn volume(&self, ref_coords: &[Vec3]) -> Result<f64>;
+
+    /// Reference volume weight `w_g det J_g` of each integration point.
+    fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>>;
+
+    /// Plastic work dissipated in the element so far, `∫ d_p dV₀` with the points'
+    /// [`PointState::plastic_dissipation`].
+    fn plastic_dissipation(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<f64> {
+        let w = self.point_volumes(ref_coords)?;
+        if w.len() != states.len() {
+            return Err(Error::input(
+                "number of states",
+                states.len(),
+                &format!("must be {}", w.len()),
+            ));
+        }
+        Ok(w.iter()
+            .zip(states)
+            .map(|(w, s)| w * s.plastic_dissipation)
+            .sum())
+    }
 
     /// Volume average of the integration-point stresses, `(1/V) ∫ σ dV` evaluated with the
     /// element's quadrature: one stress per element for output.
@@ -132,6 +200,22 @@ pub fn total_strain_energy<const D: usize, E: Element<D> + ?Sized>(
                 &states[e * np..(e + 1) * np],
                 material,
             )
+            .map(|w| sum + w)
+            .map_err(|err| in_element(err, e))
+    })
+}
+
+/// Total plastic dissipation of the mesh (sum of [`Element::plastic_dissipation`]), with
+/// the states laid out as in [`element_average_stresses`].
+pub fn total_plastic_dissipation<const D: usize, E: Element<D> + ?Sized>(
+    mesh: &Mesh,
+    element: &E,
+    states: &[PointState],
+) -> Result<f64> {
+    let np = check_state_count(mesh, element.point_count(), states)?;
+    (0..mesh.element_count()).try_fold(0.0, |sum, e| {
+        element
+            .plastic_dissipation(&mesh.hex_coordinates(e), &states[e * np..(e + 1) * np])
             .map(|w| sum + w)
             .map_err(|err| in_element(err, e))
     })

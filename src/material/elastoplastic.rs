@@ -239,11 +239,18 @@ impl Material for ElastoPlastic {
             return Ok(self.elastic.tangent());
         }
         let ret = self.return_map(&sig_tr, ebar_n)?;
+        // ε - Sσ rather than εp_n + Δλ n: exactly consistent with σ = D(ε - εp).
+        let plastic_strain = kin.strain - self.elastic.compliance() * ret.stress;
         *trial = PointState {
             stress: ret.stress,
-            // ε - Sσ rather than εp_n + Δλ n: exactly consistent with σ = D(ε - εp).
-            plastic_strain: kin.strain - self.elastic.compliance() * ret.stress,
+            plastic_strain,
             eq_plastic_strain: ebar_n + ret.dlambda,
+            // Trapezoidal, like the external work, so that the balance
+            // W_ext = Ψe + D_p closes exactly for a small-strain body.
+            plastic_dissipation: committed.plastic_dissipation
+                + 0.5
+                    * (committed.stress + ret.stress)
+                        .dot(&(plastic_strain - committed.plastic_strain)),
             ..base
         };
         Ok(ret.tangent)

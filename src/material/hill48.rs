@@ -21,10 +21,17 @@
 //! `σ·ε̇p = λ̇ φ`, so the plastic multiplier `λ̇` is the rate of the equivalent plastic
 //! strain work-conjugate to `φ`.
 //!
-//! The orthotropy axes are the global axes in this (small-strain) increment; material
-//! axes that rotate with the body come with the finite-strain formulation.
+//! # Orthotropy axes
+//!
+//! By default the axes are the global ones (rolling direction x, sheet normal z).
+//! [`Hill48::with_rolling_angle`] turns the rolling direction by an angle about z (the
+//! sheet normal): with `Q = [RD, TD, ND]` (columns, global components) the stress in the
+//! orthotropy axes is `Qᵀ σ Q = T_σ σ` (Voigt), so the global matrix is `T_σᵀ P T_σ`.
+//! Under finite kinematics the yield function acts on the log-space stress of the
+//! Lagrangian (reference) frame, so these axes are material axes: they follow the body's
+//! rotation exactly (see `material::log_strain`).
 
-use super::{Tangent, Voigt};
+use super::{stress_from_tensor, stress_to_tensor, Tangent, Voigt};
 use crate::{Error, Result};
 
 /// Hill48 yield function with coefficients `F, G, H, L, M, N`; see the module docs.
@@ -36,6 +43,10 @@ pub struct Hill48 {
     l: f64,
     m: f64,
     n: f64,
+    /// Angle of the rolling direction from x about z (radians).
+    angle: f64,
+    /// `φ² = σᵀ p σ` in global axes (cached: the return mapping uses it in every step).
+    p: Tangent,
 }
 
 impl Hill48 {
@@ -70,19 +81,52 @@ impl Hill48 {
                 "must be > 0 (positive yield function)",
             ));
         }
-        Ok(Hill48 { f, g, h, l, m, n })
+        Ok(Hill48::unchecked(f, g, h, l, m, n))
+    }
+
+    fn unchecked(f: f64, g: f64, h: f64, l: f64, m: f64, n: f64) -> Self {
+        let mut hill = Hill48 {
+            f,
+            g,
+            h,
+            l,
+            m,
+            n,
+            angle: 0.0,
+            p: Tangent::zeros(),
+        };
+        hill.p = hill.axis_matrix();
+        hill
+    }
+
+    /// The same material with its rolling direction at `angle` (radians, finite) from x,
+    /// turned about z (the sheet normal); see the module docs.
+    pub fn with_rolling_angle(self, angle: f64) -> Result<Self> {
+        if !angle.is_finite() {
+            return Err(Error::input("rolling-direction angle", angle, "must be finite"));
+        }
+        let (s, c) = angle.sin_cos();
+        let q = crate::geometry::Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        let t = Tangent::from_fn(|i, m| {
+            let mut e = Voigt::zeros();
+            e[m] = 1.0;
+            stress_from_tensor(&(q.transpose() * stress_to_tensor(&e) * q))[i]
+        });
+        Ok(Hill48 {
+            angle,
+            p: t.transpose() * self.axis_matrix() * t,
+            ..self
+        })
+    }
+
+    /// Angle of the rolling direction from x (radians).
+    pub fn rolling_angle(&self) -> f64 {
+        self.angle
     }
 
     /// Von Mises: `F = G = H = 1/2`, `L = M = N = 3/2`, `φ = sqrt(3/2 s:s)`.
     pub fn von_mises() -> Self {
-        Hill48 {
-            f: 0.5,
-            g: 0.5,
-            h: 0.5,
-            l: 1.5,
-            m: 1.5,
-            n: 1.5,
-        }
+        Hill48::unchecked(0.5, 0.5, 0.5, 1.5, 1.5, 1.5)
     }
 
     /// From the Lankford coefficients `r0, r45, r90` (finite, `> 0`), rolling direction
@@ -124,8 +168,13 @@ impl Hill48 {
         [self.f, self.g, self.h, self.l, self.m, self.n]
     }
 
-    /// The matrix `P` with `φ² = σᵀPσ` (see the module docs).
+    /// The matrix `P` with `φ² = σᵀPσ` in global axes (see the module docs).
     pub fn matrix(&self) -> Tangent {
+        self.p
+    }
+
+    /// `P` in the orthotropy axes.
+    fn axis_matrix(&self) -> Tangent {
         let (f, g, h) = (self.f, self.g, self.h);
         let mut p = Tangent::zeros();
         p[(0, 0)] = g + h;
@@ -145,13 +194,18 @@ impl Hill48 {
 
     /// Equivalent stress `φ(σ) = sqrt(σᵀPσ)`.
     pub fn equivalent_stress(&self, stress: &Voigt) -> f64 {
-        stress.dot(&(self.matrix() * stress)).max(0.0).sqrt()
+        stress.dot(&(self.p * stress)).max(0.0).sqrt()
     }
 
     /// A short description for logs.
     pub fn describe(&self) -> String {
+        let rd = if self.angle == 0.0 {
+            String::new()
+        } else {
+            format!(" RD at {} deg", self.angle.to_degrees())
+        };
         format!(
-            "Hill48 F={} G={} H={} L={} M={} N={}",
+            "Hill48 F={} G={} H={} L={} M={} N={}{rd}",
             self.f, self.g, self.h, self.l, self.m, self.n
         )
     }
@@ -190,6 +244,25 @@ mod tests {
         let ratio = 100.0 / hill.equivalent_stress(&sy);
         let expect = (r90 * (1.0 + r0) / (r0 * (1.0 + r90))).sqrt();
         assert!((ratio - expect).abs() < 1e-12);
+    }
+
+    /// Turning the rolling direction by α turns the directional yield stresses with it:
+    /// the sheet rotated by α, loaded at β + α, behaves as the original loaded at β.
+    #[test]
+    fn rolling_angle_rotates_the_axes() {
+        let hill = Hill48::from_lankford(0.7, 1.3, 2.1).unwrap();
+        let alpha = 0.4;
+        let turned = hill.with_rolling_angle(alpha).unwrap();
+        let uniaxial = |angle: f64| {
+            let (s, c) = angle.sin_cos();
+            Voigt::new(c * c, s * s, 0.0, c * s, 0.0, 0.0) * 100.0
+        };
+        for beta in [0.0, 0.3, std::f64::consts::FRAC_PI_4, 1.2] {
+            let a = hill.equivalent_stress(&uniaxial(beta));
+            let b = turned.equivalent_stress(&uniaxial(beta + alpha));
+            assert!((a - b).abs() < 1e-12, "{beta}: {a} {b}");
+        }
+        assert!(hill.with_rolling_angle(f64::NAN).is_err());
     }
 
     #[test]

@@ -35,6 +35,7 @@ mod elastoplastic;
 mod hardening;
 mod hill48;
 mod linear_elastic;
+pub mod log_strain;
 
 pub use elastoplastic::ElastoPlastic;
 pub use hardening::Hardening;
@@ -73,6 +74,15 @@ pub struct PointState {
     /// `f = F_{n+1} F_n⁻¹` between the committed and the trial state (objective
     /// stress updates, rotation of anisotropy axes).
     pub deformation_gradient: Mat3,
+    /// Under finite kinematics ([`Material::update_finite`]): the stress `T` work-conjugate
+    /// to the logarithmic strain `strain`, the material's own stress measure (the elastic
+    /// energy and the return mapping live in it); `stress` then holds the Cauchy stress.
+    /// Zero under small strain.
+    pub log_stress: Voigt,
+    /// Plastic work dissipated so far per unit reference volume, `∫ σ·dεp` (small strain)
+    /// or `∫ T·dEp` (finite strain), accumulated by the trapezoidal rule per increment
+    /// (exact energy balance with the trapezoidal external work at small strain).
+    pub plastic_dissipation: f64,
 }
 
 impl Default for PointState {
@@ -84,8 +94,19 @@ impl Default for PointState {
             plastic_strain: Voigt::zeros(),
             eq_plastic_strain: 0.0,
             deformation_gradient: Mat3::identity(),
+            log_stress: Voigt::zeros(),
+            plastic_dissipation: 0.0,
         }
     }
+}
+
+/// Output of a finite-strain material update ([`Material::update_finite`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FiniteResponse {
+    /// Second Piola-Kirchhoff stress `S` (Voigt, tensor shear).
+    pub pk2: Voigt,
+    /// Material tangent `∂S/∂E_GL` (Voigt; Green-Lagrange strain with engineering shear).
+    pub tangent: Tangent,
 }
 
 /// Kinematic input of a material update at one integration point, at the end of the
@@ -138,6 +159,25 @@ pub trait Material: std::fmt::Debug + Send + Sync {
         committed: &PointState,
         trial: &mut PointState,
     ) -> Result<Tangent>;
+
+    /// Finite-strain update at the deformation gradient `f` (an F-bar element passes its
+    /// modified gradient): returns the second Piola-Kirchhoff stress and `∂S/∂E_GL`, and
+    /// writes the Cauchy stress into `trial.stress`, the log-space stress into
+    /// `trial.log_stress`, the logarithmic strain into `trial.strain`.
+    ///
+    /// The default is the Lagrangian logarithmic-strain extension of the small-strain
+    /// model ([`log_strain::lagrangian_update`]): [`update`](Self::update) is applied to
+    /// `E = ½ ln C` unchanged, so [`LinearElastic`] becomes Hencky hyperelasticity and
+    /// [`ElastoPlastic`] log-strain hyperelasto-plasticity with material (reference-frame)
+    /// orthotropy axes.
+    fn update_finite(
+        &self,
+        f: &Mat3,
+        committed: &PointState,
+        trial: &mut PointState,
+    ) -> Result<FiniteResponse> {
+        log_strain::lagrangian_update(self, f, committed, trial)
+    }
 
     /// The elastic tangent (initial stiffness), e.g. for a first predictor or a
     /// stiffness-proportional damping or penalty scale.

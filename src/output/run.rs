@@ -56,6 +56,7 @@ impl RunOutput {
             "load_work",
             "support_work",
             "elastic_energy",
+            "plastic_dissipation",
             "energy_balance_error",
         ] {
             columns.push(name.to_string());
@@ -103,6 +104,7 @@ impl RunOutput {
             e.load_work,
             e.support_work,
             e.elastic_energy,
+            e.plastic_dissipation,
             e.relative_error,
         ]);
         self.history.append(&row)
@@ -286,6 +288,7 @@ pub fn frame(sim: &Simulation) -> Frame {
         cell_data: vec![
             Field::new("stress", 6, stress),
             Field::scalar("von_mises", von_mises),
+            Field::scalar("equivalent_plastic_strain", eq_plastic),
         ],
     }
 }

@@ -19,7 +19,7 @@ use crate::contact::{
     alart_curnier, BernsteinLaw, ContactNodeState, Enforcement, FrictionUpdate, NodalContact,
     OperatorParams,
 };
-use crate::element::{in_element, Element, ElementResponse, Hex8};
+use crate::element::{hexahedron, in_element, ElementResponse};
 use crate::geometry::{Mat3, Projection, Vec3};
 use crate::material::PointState;
 use crate::tool::pose::Pose;
@@ -156,7 +156,7 @@ impl IncrementContext<'_> {
         let mut trial_points = self.committed_points.to_vec();
 
         let t0 = Instant::now();
-        let element = Hex8;
+        let element = hexahedron(model.settings.kinematics);
         let per_elem = element.point_count();
         let mut xs = [Vec3::zeros(); 8];
         let mut us = [Vec3::zeros(); 8];

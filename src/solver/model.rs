@@ -64,6 +64,9 @@ pub struct SolverSettings {
     /// Eliminate the multipliers of single-pair, unconstrained contact nodes before the
     /// linear solve (same Newton iterates, smaller factorization; see `condense`).
     pub eliminate_multipliers: bool,
+    /// Small strain (B-bar hexahedra, the default) or finite strain (total-Lagrangian
+    /// F-bar hexahedra, Lagrangian log-strain material update).
+    pub kinematics: crate::element::StrainTheory,
 }
 
 impl Default for SolverSettings {
@@ -78,6 +81,7 @@ impl Default for SolverSettings {
             max_cutbacks: 4,
             contact: ContactSettings::default(),
             eliminate_multipliers: true,
+            kinematics: crate::element::StrainTheory::Small,
         }
     }
 }

@@ -570,15 +570,21 @@ impl Simulation {
             e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);
             e.frictional_dissipation[c] += dissipated[c];
         }
+        let element = crate::element::hexahedron(self.model.settings.kinematics);
         e.elastic_energy = crate::element::total_strain_energy(
             &self.model.mesh,
-            &Hex8,
+            element,
             &eval.trial_points,
             self.model.material.as_ref(),
         )
         .unwrap_or(f64::NAN);
+        e.plastic_dissipation =
+            crate::element::total_plastic_dissipation(&self.model.mesh, element, &eval.trial_points)
+                .unwrap_or(f64::NAN);
         let input = e.tool_work + e.load_work + e.support_work;
-        let stored: f64 = e.elastic_energy + e.frictional_dissipation.iter().sum::<f64>();
+        let stored: f64 = e.elastic_energy
+            + e.plastic_dissipation
+            + e.frictional_dissipation.iter().sum::<f64>();
         let scale =
             (e.tool_work.abs() + e.load_work.abs() + e.support_work.abs()).max(stored.abs());
         e.relative_error = if scale > 0.0 {
@@ -643,6 +649,9 @@ pub struct EnergyBalance {
     pub support_work: f64,
     /// Elastic energy stored in the body now.
     pub elastic_energy: f64,
+    /// Plastic work dissipated in the body so far (trapezoidal per increment, see
+    /// `PointState::plastic_dissipation`).
+    pub plastic_dissipation: f64,
     /// Frictional dissipation per tool: the work of the contact forces on the slip,
     /// 1/2 (lambda_n + lambda_{n+1}) . delta per node and increment, the same trapezoidal
     /// rule as the other work terms, which makes the balance exact for elastic bodies. The
