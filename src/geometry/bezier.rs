@@ -276,10 +276,11 @@ impl BezierPatch {
         let (bu, bv) = (values(self.degree_u, u), values(self.degree_v, v));
         let nv = self.degree_v + 1;
         let (mut a, mut w) = (Vec3::zeros(), 0.0);
-        for i in 0..=self.degree_u {
-            for j in 0..nv {
-                let wb = self.weights[i * nv + j] * bu[i] * bv[j];
-                a += self.points[i * nv + j] * wb;
+        let rows = self.points.chunks(nv).zip(self.weights.chunks(nv));
+        for ((points, weights), bi) in rows.zip(&bu) {
+            for ((p, wij), bj) in points.iter().zip(weights).zip(&bv) {
+                let wb = wij * bi * bj;
+                a += p * wb;
                 w += wb;
             }
         }
