@@ -5,10 +5,11 @@
 //! above the flat top, some inside the opening down to the wall): cold start (no hint),
 //! warm start (each node moved by up to 0.05 mm from where it was projected, with its
 //! previous foot as hint, as between Newton iterations), each with the bounding-volume
-//! hierarchy and with a full sort of the patch boxes instead.
+//! hierarchy and with a full sort of the patch boxes instead. A wavy quilt of 4096 bilinear
+//! patches over the same plan shows the tree's effect with many patches.
 use std::time::Instant;
 use tribo::geometry::builders::{die_patches, DieSpec, Extent};
-use tribo::geometry::{PatchSurface, RigidSurface, SurfaceHint, Vec3};
+use tribo::geometry::{BezierPatch, PatchSurface, RigidSurface, SurfaceHint, Vec3};
 
 fn main() {
     let count: usize = std::env::args()
@@ -48,11 +49,34 @@ fn main() {
     println!("{count} nodes");
     println!("| tool | patches | search | cold start | warm start |");
     println!("|---|---|---|---|---|");
-    for (name, extent) in [
-        ("full die", Extent::Full),
-        ("quarter die", Extent::Quarter { margin: 5.0 }),
+    // A wavy quilt of 64 x 64 bilinear patches over the same plan: many patches, where the
+    // tree has to prune.
+    let quilt: Vec<BezierPatch> = {
+        let (n, h) = (64, 160.0 / 64.0);
+        let z = |i: usize, j: usize| 0.3 * ((i as f64) * 0.7).sin() * ((j as f64) * 0.5).cos();
+        let corner =
+            |i: usize, j: usize| Vec3::new(-80.0 + i as f64 * h, -80.0 + j as f64 * h, z(i, j));
+        (0..n)
+            .flat_map(|i| (0..n).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let pts = vec![
+                    corner(i, j),
+                    corner(i, j + 1),
+                    corner(i + 1, j),
+                    corner(i + 1, j + 1),
+                ];
+                BezierPatch::new(1, 1, pts, vec![1.0; 4]).unwrap()
+            })
+            .collect()
+    };
+    for (name, patches) in [
+        ("full die", die_patches(&spec, Extent::Full).unwrap()),
+        (
+            "quarter die",
+            die_patches(&spec, Extent::Quarter { margin: 5.0 }).unwrap(),
+        ),
+        ("quilt 64 x 64", quilt),
     ] {
-        let patches = die_patches(&spec, extent).unwrap();
         let n_patches = patches.len();
         for bvh in [true, false] {
             let mut surface = PatchSurface::new(patches.clone()).unwrap();

@@ -192,7 +192,11 @@ fn large_slip_across_many_seams_converges_without_chattering() {
 fn rotated_bezier_tool_projects_like_the_rotated_analytic_cylinder() {
     use tribo::geometry::{Cylinder, RigidSurface};
     use tribo::tool::{schedule::Schedule, Pose, Tool};
-    let (c, a, r) = (Vec3::new(1.0, -2.0, 0.5), Vec3::new(0.1, 1.0, 0.2).normalize(), 2.0);
+    let (c, a, r) = (
+        Vec3::new(1.0, -2.0, 0.5),
+        Vec3::new(0.1, 1.0, 0.2).normalize(),
+        2.0,
+    );
     let patches = (0..4)
         .map(|q| {
             BezierPatch::quarter_cylinder(c - a * 5.0, a, Vec3::x(), q as f64 * FRAC_PI_2, r, 10.0)
@@ -221,12 +225,8 @@ fn rotated_bezier_tool_projects_like_the_rotated_analytic_cylinder() {
             &tool.schedule.translation(time),
         );
         assert!((pose.rotation - by_hand.rotation).norm() < 1e-14);
-        let placed = Cylinder::new(
-            by_hand.to_global_point(&c),
-            by_hand.to_global_vector(&a),
-            r,
-        )
-        .unwrap();
+        let placed =
+            Cylinder::new(by_hand.to_global_point(&c), by_hand.to_global_vector(&a), r).unwrap();
         let mut hint = None;
         for _ in 0..500 {
             // Within the patches' length (axial offset < 4 of 5), up to 3.5 off the axis.

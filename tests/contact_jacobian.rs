@@ -230,7 +230,11 @@ fn jacobian_matches_finite_differences_on_patch_tools() {
     let cases = [
         ("punch torus interior", &punch, corner(40.0, -50.0)),
         ("punch torus near wall", &punch, corner(40.0, -seam_angle)),
-        ("punch torus near flat", &punch, corner(40.0, -90.0 + seam_angle)),
+        (
+            "punch torus near flat",
+            &punch,
+            corner(40.0, -90.0 + seam_angle),
+        ),
         ("punch torus near side", &punch, corner(seam_angle, -40.0)),
         (
             "punch flat overlap",

@@ -45,50 +45,99 @@ pub struct PatchPoint {
     pub svv: Vec3,
 }
 
-/// Bernstein values of degree `n` at `t`, and their first and second derivatives, from the
-/// lower-degree bases: `B'_i^n = n (B_{i-1}^{n-1} - B_i^{n-1})` and similarly twice.
-fn bernstein_with_derivatives(n: usize, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    // All degrees 0..=n by the triangle B_i^k = (1-t) B_i^{k-1} + t B_{i-1}^{k-1}.
-    let mut by_degree: Vec<Vec<f64>> = vec![vec![1.0]];
+/// Degrees up to this are evaluated in stack buffers (no allocation per evaluation).
+const STACK_DEGREE: usize = 15;
+
+/// Bernstein values of degree `n` at `t` and their first and second derivatives, from the
+/// lower-degree bases: `B'_i^n = n (B_{i-1}^{n-1} - B_i^{n-1})` and similarly twice. All
+/// degrees come from the triangle `B_i^k = (1-t) B_i^{k-1} + t B_{i-1}^{k-1}`, run in place;
+/// `out` holds `[B, B', B'']`, each of length at least `n + 1`.
+fn bernstein_into(n: usize, t: f64, out: [&mut [f64]; 3]) {
+    let [b, d1, d2] = out;
+    let (mut lower1, mut lower2) = ([0.0; STACK_DEGREE + 2], [0.0; STACK_DEGREE + 2]);
+    let mut heap1;
+    let mut heap2;
+    let (deg1, deg2): (&mut [f64], &mut [f64]) = if n <= STACK_DEGREE {
+        (&mut lower1[..], &mut lower2[..])
+    } else {
+        heap1 = vec![0.0; n + 2];
+        heap2 = vec![0.0; n + 2];
+        (&mut heap1[..], &mut heap2[..])
+    };
+    b[0] = 1.0;
     for k in 1..=n {
-        let prev = &by_degree[k - 1];
-        let row = (0..=k)
-            .map(|i| {
-                let left = if i < k { (1.0 - t) * prev[i] } else { 0.0 };
-                let right = if i > 0 { t * prev[i - 1] } else { 0.0 };
-                left + right
-            })
-            .collect();
-        by_degree.push(row);
+        if k == n {
+            deg1[..n].copy_from_slice(&b[..n]);
+        }
+        if k + 1 == n {
+            deg2[..n - 1].copy_from_slice(&b[..n - 1]);
+        }
+        b[k] = t * b[k - 1];
+        for i in (1..k).rev() {
+            b[i] = (1.0 - t) * b[i] + t * b[i - 1];
+        }
+        b[0] *= 1.0 - t;
     }
-    let lower = |k: usize, i: isize| -> f64 {
+    let nf = n as f64;
+    let lower = |arr: &[f64], k: usize, i: isize| -> f64 {
         if i < 0 || i as usize > k {
             0.0
         } else {
-            by_degree[k][i as usize]
+            arr[i as usize]
         }
     };
-    let nf = n as f64;
-    let d1 = (0..=n as isize)
-        .map(|i| {
-            if n == 0 {
-                0.0
-            } else {
-                nf * (lower(n - 1, i - 1) - lower(n - 1, i))
-            }
-        })
-        .collect();
-    let d2 = (0..=n as isize)
-        .map(|i| {
-            if n < 2 {
-                0.0
-            } else {
-                nf * (nf - 1.0)
-                    * (lower(n - 2, i - 2) - 2.0 * lower(n - 2, i - 1) + lower(n - 2, i))
-            }
-        })
-        .collect();
-    (by_degree.pop().unwrap(), d1, d2)
+    for i in 0..=n as isize {
+        d1[i as usize] = if n == 0 {
+            0.0
+        } else {
+            nf * (lower(deg1, n - 1, i - 1) - lower(deg1, n - 1, i))
+        };
+        d2[i as usize] = if n < 2 {
+            0.0
+        } else {
+            nf * (nf - 1.0)
+                * (lower(deg2, n - 2, i - 2) - 2.0 * lower(deg2, n - 2, i - 1)
+                    + lower(deg2, n - 2, i))
+        };
+    }
+}
+
+/// Bernstein values and derivatives of degree `n` at `t` in a buffer on the stack for
+/// degrees up to [`STACK_DEGREE`], on the heap beyond.
+struct Basis {
+    stack: [[f64; STACK_DEGREE + 1]; 3],
+    heap: Vec<Vec<f64>>,
+    n: usize,
+}
+
+impl Basis {
+    fn new(n: usize, t: f64) -> Basis {
+        let mut basis = Basis {
+            stack: [[0.0; STACK_DEGREE + 1]; 3],
+            heap: Vec::new(),
+            n,
+        };
+        if n <= STACK_DEGREE {
+            let [b, d1, d2] = &mut basis.stack;
+            bernstein_into(n, t, [b, d1, d2]);
+        } else {
+            let mut v = vec![vec![0.0; n + 1]; 3];
+            let (b, rest) = v.split_at_mut(1);
+            let (d1, d2) = rest.split_at_mut(1);
+            bernstein_into(n, t, [&mut b[0], &mut d1[0], &mut d2[0]]);
+            basis.heap = v;
+        }
+        basis
+    }
+
+    /// `[B, B', B'']`.
+    fn get(&self, k: usize) -> &[f64] {
+        if self.n <= STACK_DEGREE {
+            &self.stack[k][..=self.n]
+        } else {
+            &self.heap[k]
+        }
+    }
 }
 
 impl BezierPatch {
@@ -207,11 +256,43 @@ impl BezierPatch {
         (hi - lo).norm()
     }
 
+    /// The point `S(u, v)` alone (cheaper than [`BezierPatch::evaluate`]; for sampling).
+    pub fn point(&self, u: f64, v: f64) -> Vec3 {
+        if self.degree_u > STACK_DEGREE || self.degree_v > STACK_DEGREE {
+            return self.evaluate(u, v).point;
+        }
+        let values = |n: usize, t: f64| {
+            let mut b = [0.0; STACK_DEGREE + 1];
+            b[0] = 1.0;
+            for k in 1..=n {
+                b[k] = t * b[k - 1];
+                for i in (1..k).rev() {
+                    b[i] = (1.0 - t) * b[i] + t * b[i - 1];
+                }
+                b[0] *= 1.0 - t;
+            }
+            b
+        };
+        let (bu, bv) = (values(self.degree_u, u), values(self.degree_v, v));
+        let nv = self.degree_v + 1;
+        let (mut a, mut w) = (Vec3::zeros(), 0.0);
+        let rows = self.points.chunks(nv).zip(self.weights.chunks(nv));
+        for ((points, weights), bi) in rows.zip(&bu) {
+            for ((p, wij), bj) in points.iter().zip(weights).zip(&bv) {
+                let wb = wij * bi * bj;
+                a += p * wb;
+                w += wb;
+            }
+        }
+        a / w
+    }
+
     /// Point, first and second derivatives at `(u, v)` (any real values; the patch is
     /// usually queried on `[0, 1]^2`).
     pub fn evaluate(&self, u: f64, v: f64) -> PatchPoint {
-        let (bu, du, ddu) = bernstein_with_derivatives(self.degree_u, u);
-        let (bv, dv, ddv) = bernstein_with_derivatives(self.degree_v, v);
+        let (basis_u, basis_v) = (Basis::new(self.degree_u, u), Basis::new(self.degree_v, v));
+        let (bu, du, ddu) = (basis_u.get(0), basis_u.get(1), basis_u.get(2));
+        let (bv, dv, ddv) = (basis_v.get(0), basis_v.get(1), basis_v.get(2));
         // Homogeneous sums: index 0 value, 1 d/du, 2 d/dv, 3 d2/du2, 4 d2/dudv, 5 d2/dv2.
         let mut a = [Vec3::zeros(); 6];
         let mut w = [0.0; 6];
@@ -528,6 +609,43 @@ mod tests {
             close((vp.sv - vm.sv) / (2.0 * h), e.svv, 1e-7);
             close((vp.su - vm.su) / (2.0 * h), e.suv, 1e-7);
             close((up.sv - um.sv) / (2.0 * h), e.suv, 1e-7);
+        }
+    }
+
+    /// Partition of unity and central differences of the basis, on the stack (degree <= 15)
+    /// and on the heap (beyond).
+    #[test]
+    fn bernstein_basis_on_stack_and_heap() {
+        let h = 1e-6;
+        for n in 0..=20 {
+            for t in [0.0, 0.13, 0.5, 0.91, 1.0] {
+                let b = Basis::new(n, t);
+                let (bp, bm) = (Basis::new(n, t + h), Basis::new(n, t - h));
+                assert!((b.get(0).iter().sum::<f64>() - 1.0).abs() < 1e-14);
+                for i in 0..=n {
+                    let fd1 = (bp.get(0)[i] - bm.get(0)[i]) / (2.0 * h);
+                    let fd2 = (bp.get(1)[i] - bm.get(1)[i]) / (2.0 * h);
+                    let scale = 1.0 + (n * n) as f64;
+                    assert!(
+                        (fd1 - b.get(1)[i]).abs() < 1e-7 * scale,
+                        "n {n} t {t} i {i}"
+                    );
+                    assert!(
+                        (fd2 - b.get(2)[i]).abs() < 1e-5 * scale * scale,
+                        "n {n} t {t} i {i}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn point_equals_the_full_evaluation() {
+        let mut rng = Rng::new(44);
+        for _ in 0..50 {
+            let patch = random_patch(&mut rng);
+            let (u, v) = (rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+            assert!((patch.point(u, v) - patch.evaluate(u, v).point).norm() < 1e-14);
         }
     }
 

@@ -191,7 +191,7 @@ impl PatchSurface {
     /// Closest point on patch `k`, from `start` (warm) or from the best of a coarse grid.
     pub(crate) fn closest_on_patch(&self, k: usize, x: &Vec3, start: Option<(f64, f64)>) -> Local {
         let patch = &self.patches[k];
-        let dist2 = |u: f64, v: f64| (patch.evaluate(u, v).point - x).norm_squared();
+        let dist2 = |u: f64, v: f64| (patch.point(u, v) - x).norm_squared();
         let (mut u, mut v) = match start {
             Some((u, v)) => (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0)),
             None => {
@@ -405,7 +405,20 @@ impl RigidSurface for PatchSurface {
         let mut best: Option<(usize, Local)> =
             hinted.map(|h| (h.patch, self.closest_on_patch(h.patch, x, Some((h.u, h.v)))));
         let hinted_patch = hinted.map(|h| h.patch);
-        let bound = best.as_ref().map_or(f64::INFINITY, |(_, b)| b.dist + tol);
+        // Pruning bound: a candidate replaces the best only if closer by the hysteresis
+        // margin, or equally close (within tol) with a better-ranked foot. An interior best
+        // cannot be out-ranked, so then no box farther than its distance minus the margin
+        // can hold a winner (less 1e-14 of the size, so that a flat patch's box, exactly
+        // at the distance, is skipped despite the rounding of the foot's distance).
+        let bound_of = |best: &Option<(usize, Local)>| match best {
+            None => f64::INFINITY,
+            Some((kb, b)) if b.kind == Kind::Interior => {
+                let margin = if Some(*kb) == hinted_patch { tol } else { 0.0 };
+                b.dist - margin - 1e-14 * self.scale
+            }
+            Some((_, b)) => b.dist + tol,
+        };
+        let bound = bound_of(&best);
         self.nearest_patches(x, bound, |k, _| {
             if Some(k) != hinted_patch {
                 let c = self.closest_on_patch(k, x, None);
@@ -424,7 +437,7 @@ impl RigidSurface for PatchSurface {
                     best = Some((k, c));
                 }
             }
-            best.as_ref().map_or(f64::INFINITY, |(_, b)| b.dist + tol)
+            bound_of(&best)
         });
         let (k, loc) = best?;
         self.finish(k, &loc, x)
