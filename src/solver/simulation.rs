@@ -431,11 +431,11 @@ impl Simulation {
             .model
             .dirichlet
             .iter()
+            .filter(|bc| bc.value.value(t_new) != bc.value.value(self.time))
             .flat_map(|bc| {
                 let v = bc.value.value(t_new);
                 bc.nodes.iter().map(move |&n| (3 * n + bc.component, v))
             })
-            .filter(|&(d, v)| x[d] != v)
             .collect();
         if jumps.is_empty() {
             return Ok(());
