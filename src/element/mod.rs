@@ -60,12 +60,17 @@ impl StrainTheory {
 }
 
 /// The hexahedron of a strain theory (both have the 2x2x2 points in the same order).
-pub fn hexahedron(theory: StrainTheory) -> &'static dyn Element<{ hex8::DOFS }> {
+/// `fbar = false` drops the F-bar modification of the finite-strain element (a fully
+/// integrated total-Lagrangian hexahedron, which locks in nearly incompressible flow: for
+/// verification only); the small-strain element is always B-bar.
+pub fn hexahedron(theory: StrainTheory, fbar: bool) -> &'static dyn Element<{ hex8::DOFS }> {
     static SMALL: Hex8 = Hex8;
     static FINITE: Hex8FBar = Hex8FBar { fbar: true };
-    match theory {
-        StrainTheory::Small => &SMALL,
-        StrainTheory::Finite => &FINITE,
+    static FINITE_FULL: Hex8FBar = Hex8FBar { fbar: false };
+    match (theory, fbar) {
+        (StrainTheory::Small, _) => &SMALL,
+        (StrainTheory::Finite, true) => &FINITE,
+        (StrainTheory::Finite, false) => &FINITE_FULL,
     }
 }
 

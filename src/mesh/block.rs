@@ -52,7 +52,8 @@ impl Mesh {
     /// `i + (cells[0] + 1) * (j + (cells[1] + 1) * k)`; the element (i, j, k) has index
     /// `i + cells[0] * (j + cells[1] * k)` and VTK_HEXAHEDRON connectivity (positive
     /// Jacobian). The six faces of the box are the node sets "x-", "x+", "y-", "y+", "z-",
-    /// "z+" ("x-" = the nodes with i = 0, ...).
+    /// "z+" ("x-" = the nodes with i = 0, ...). The through-thickness node columns along z
+    /// (i, j fixed, k from 0 up) are kept as [`Mesh::columns`] for thickness output.
     ///
     /// Errors: a zero cell count, a non-positive or non-finite size, a non-finite origin, a
     /// grading ratio that is not finite and > 0 (or so extreme that cells collapse), more
@@ -153,10 +154,16 @@ impl Mesh {
             node_sets.insert(format!("{name}+"), face(axis, cells[axis]));
         }
 
+        // Sheet columns along z (the thickness direction of a block used as a sheet).
+        let columns = (0..=ny)
+            .flat_map(|j| (0..=nx).map(move |i| (i, j)))
+            .map(|(i, j)| (0..=nz).map(|k| node(i, j, k)).collect())
+            .collect();
         Ok(Mesh {
             nodes,
             hexes,
             node_sets,
+            columns,
         })
     }
 }
@@ -430,5 +437,28 @@ mod tests {
             [extreme, Grading::Uniform, Grading::Uniform],
         ));
         assert!(e.contains("zero width"), "{e}");
+    }
+
+    /// Columns run bottom to top through the thickness, one per (i, j), and their length
+    /// is the thickness; a uniform through-thickness stretch scales it.
+    #[test]
+    fn columns_measure_the_thickness() {
+        let m = Mesh::block(Vec3::zeros(), Vec3::new(4.0, 2.0, 0.8), [4, 2, 3]).unwrap();
+        assert_eq!(m.columns().len(), 5 * 3);
+        for col in m.columns() {
+            assert_eq!(col.len(), 4);
+            let p0 = m.nodes[col[0]];
+            assert_eq!(p0.z, 0.0);
+            for w in col.windows(2) {
+                let (a, b) = (m.nodes[w[0]], m.nodes[w[1]]);
+                assert!(a.x == b.x && a.y == b.y && b.z > a.z);
+            }
+        }
+        let t = m.column_thicknesses(|n| Vec3::new(0.3, 0.0, -0.1 * m.nodes[n].z));
+        assert!(t.iter().all(|t| (t - 0.72).abs() < 1e-14));
+        assert!(Mesh::new(m.nodes.clone(), m.hexes.clone())
+            .unwrap()
+            .columns()
+            .is_empty());
     }
 }

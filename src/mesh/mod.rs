@@ -77,6 +77,8 @@ pub struct Mesh {
     pub hexes: Vec<[usize; 8]>,
     /// Named node sets, each sorted ascending without duplicates.
     node_sets: BTreeMap<String, Vec<usize>>,
+    /// Through-thickness node columns of a sheet (see [`Mesh::columns`]).
+    columns: Vec<Vec<usize>>,
 }
 
 impl Mesh {
@@ -87,9 +89,34 @@ impl Mesh {
             nodes,
             hexes,
             node_sets: BTreeMap::new(),
+            columns: Vec::new(),
         };
         mesh.validate()?;
         Ok(mesh)
+    }
+
+    /// Through-thickness node columns, bottom to top, when the mesh is a sheet whose
+    /// thickness direction is known (a block: its z axis, the sheet normal); empty
+    /// otherwise. Each column's current length is the sheet's current thickness there.
+    pub fn columns(&self) -> &[Vec<usize>] {
+        &self.columns
+    }
+
+    /// Current thickness of every column (the length of the polyline through its nodes at
+    /// the reference positions plus `displacement(node)`), in column order.
+    pub fn column_thicknesses(&self, displacement: impl Fn(usize) -> Vec3) -> Vec<f64> {
+        self.columns
+            .iter()
+            .map(|col| {
+                col.windows(2)
+                    .map(|w| {
+                        let a = self.nodes[w[0]] + displacement(w[0]);
+                        let b = self.nodes[w[1]] + displacement(w[1]);
+                        (b - a).norm()
+                    })
+                    .sum()
+            })
+            .collect()
     }
 
     /// Number of nodes.

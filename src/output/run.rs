@@ -4,6 +4,7 @@
 
 use super::{write_summary, write_vtu, Field, Frame, HistoryCsv, OutputFolder, PvdSeries};
 use crate::contact::ContactStatus;
+use crate::geometry::Vec3;
 use crate::solver::{IncrementReport, Simulation};
 use crate::Result;
 use std::path::Path;
@@ -181,6 +182,7 @@ impl RunOutput {
                 "contact": sim.phase_times.contact,
                 "factorization_and_solve": sim.phase_times.factorization_and_solve,
             },
+            "kinematics": settings.kinematics.name(),
             "nodes": sim.model.mesh.nodes.len(),
             "elements": sim.model.mesh.hexes.len(),
             "contact": {
@@ -207,8 +209,10 @@ impl RunOutput {
     }
 }
 
-/// The committed state as a VTK frame: displacement and contact fields on the nodes,
-/// element-averaged stress on the cells. A node touching several tools shows the tool
+/// The committed state as a VTK frame: displacement and contact fields on the nodes (and,
+/// for sheet meshes with through-thickness columns, the current thickness and the
+/// thickness strain ln(t/t0) of each column on its nodes), element-averaged Cauchy stress,
+/// von Mises stress and equivalent plastic strain on the cells. A node touching several tools shows the tool
 /// pressing it hardest.
 pub fn frame(sim: &Simulation) -> Frame {
     let mesh = &sim.model.mesh;
@@ -268,6 +272,23 @@ pub fn frame(sim: &Simulation) -> Frame {
             + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]))
             .sqrt();
     }
+    // Sheet thickness per through-thickness column (block meshes), on the column's nodes.
+    let mut sheet_fields = Vec::new();
+    if !mesh.columns().is_empty() {
+        let disp = |n: usize| Vec3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2]);
+        let current = mesh.column_thicknesses(disp);
+        let initial = mesh.column_thicknesses(|_| Vec3::zeros());
+        let mut thickness = vec![0.0; n];
+        let mut thickness_strain = vec![0.0; n];
+        for (k, col) in mesh.columns().iter().enumerate() {
+            for &node in col {
+                thickness[node] = current[k];
+                thickness_strain[node] = (current[k] / initial[k]).ln();
+            }
+        }
+        sheet_fields.push(Field::scalar("thickness", thickness));
+        sheet_fields.push(Field::scalar("thickness_strain", thickness_strain));
+    }
     // VTK orders symmetric tensors xx, yy, zz, xy, yz, xz, as our Voigt vector.
     Frame {
         points: mesh.nodes.iter().map(|p| [p.x, p.y, p.z]).collect(),
@@ -284,7 +305,10 @@ pub fn frame(sim: &Simulation) -> Frame {
             Field::scalar("mu", mu),
             Field::scalar("theta", theta),
             Field::scalar("stick_slip_flips", flips),
-        ],
+        ]
+        .into_iter()
+        .chain(sheet_fields)
+        .collect(),
         cell_data: vec![
             Field::new("stress", 6, stress),
             Field::scalar("von_mises", von_mises),

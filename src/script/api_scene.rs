@@ -268,6 +268,37 @@ fn register_material(engine: &mut Engine) {
             ))
         },
     );
+    // hill48(r0, r45, r90, rd): rolling direction at rd degrees from x about z.
+    engine.register_fn(
+        "hill48",
+        |r0: Dynamic, r45: Dynamic, r90: Dynamic, rd: Dynamic| -> ScriptResult<Hill48> {
+            let hill = lift(Hill48::from_lankford(
+                number(&r0, "r0")?,
+                number(&r45, "r45")?,
+                number(&r90, "r90")?,
+            ))?;
+            lift(hill.with_rolling_angle(number(&rd, "rolling-direction angle")?.to_radians()))
+        },
+    );
+    engine.register_fn(
+        "hill48_coefficients",
+        |f: Dynamic, g: Dynamic, h: Dynamic, l: Dynamic, m: Dynamic, n: Dynamic| -> ScriptResult<Hill48> {
+            lift(Hill48::new(
+                number(&f, "Hill48 F")?,
+                number(&g, "Hill48 G")?,
+                number(&h, "Hill48 H")?,
+                number(&l, "Hill48 L")?,
+                number(&m, "Hill48 M")?,
+                number(&n, "Hill48 N")?,
+            ))
+        },
+    );
+    engine.register_fn(
+        "rolling_direction",
+        |hill: &mut Hill48, rd: Dynamic| -> ScriptResult<Hill48> {
+            lift(hill.with_rolling_angle(number(&rd, "rolling-direction angle")?.to_radians()))
+        },
+    );
     engine.register_fn(
         "elastoplastic",
         |e: Dynamic,

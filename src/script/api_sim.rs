@@ -241,6 +241,16 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
                     .map_err(|t| format!("eliminate_multipliers must be true or false, got {t}"))
                     .or_else(runtime_error)?
             }
+            "kinematics" => {
+                let name = v.clone().into_string().unwrap_or_default();
+                s.kinematics = lift(crate::element::StrainTheory::from_name(&name))?;
+            }
+            "fbar" => {
+                s.fbar = v
+                    .as_bool()
+                    .map_err(|t| format!("fbar must be true or false, got {t}"))
+                    .or_else(runtime_error)?
+            }
             "friction_update" => {
                 s.contact.friction_update = match v.clone().into_string().unwrap_or_default().as_str() {
                     "explicit" => crate::contact::FrictionUpdate::Explicit,
@@ -271,7 +281,7 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, curvature, frame, enforcement, friction_update, eliminate_multipliers)"
+                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, kinematics, fbar)"
                 ))
             }
         }

@@ -156,7 +156,7 @@ impl IncrementContext<'_> {
         let mut trial_points = self.committed_points.to_vec();
 
         let t0 = Instant::now();
-        let element = hexahedron(model.settings.kinematics);
+        let element = hexahedron(model.settings.kinematics, model.settings.fbar);
         let per_elem = element.point_count();
         let mut xs = [Vec3::zeros(); 8];
         let mut us = [Vec3::zeros(); 8];

@@ -67,6 +67,9 @@ pub struct SolverSettings {
     /// Small strain (B-bar hexahedra, the default) or finite strain (total-Lagrangian
     /// F-bar hexahedra, Lagrangian log-strain material update).
     pub kinematics: crate::element::StrainTheory,
+    /// F-bar volumetric treatment of the finite-strain hexahedron (default on; off gives
+    /// the fully integrated element, which locks: for verification only).
+    pub fbar: bool,
 }
 
 impl Default for SolverSettings {
@@ -82,6 +85,7 @@ impl Default for SolverSettings {
             contact: ContactSettings::default(),
             eliminate_multipliers: true,
             kinematics: crate::element::StrainTheory::Small,
+            fbar: true,
         }
     }
 }

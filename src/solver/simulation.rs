@@ -361,18 +361,19 @@ impl Simulation {
     )> {
         let settings = self.model.settings.clone();
         let mut x = self.x.clone();
-        for bc in &self.model.dirichlet {
-            let v = bc.value.value(t_new);
-            for &node in &bc.nodes {
-                x[3 * node + bc.component] = v;
-            }
-        }
         let frozen = match settings.contact.frame {
             FrameUpdate::EveryIteration => None,
             FrameUpdate::Frozen => Some(self.frozen_frames(t_new)),
         };
         let ctx = self.context(t_new, frozen);
         let mut times = PhaseTimes::default();
+        self.dirichlet_predictor(&ctx, t_new, &mut x, linear, &mut times)?;
+        for bc in &self.model.dirichlet {
+            let v = bc.value.value(t_new);
+            for &node in &bc.nodes {
+                x[3 * node + bc.component] = v;
+            }
+        }
         let mut residuals = Vec::new();
         let mut iterations = 0;
         let n_u = 3 * self.dofs.n_nodes;
@@ -425,6 +426,46 @@ impl Simulation {
             iterations += 1;
         };
         Ok((x, eval, iterations, residuals, times))
+    }
+
+    /// Linearised Dirichlet predictor: when prescribed values change, the first update
+    /// solves the tangent system at the committed state with the prescribed increments as
+    /// its constraint rows, so the increment's jump spreads over the body instead of
+    /// straining only the elements next to the moved nodes (such a first iterate can
+    /// carry a plastic body far outside Newton's basin). For a linear problem the
+    /// predictor is the solution.
+    fn dirichlet_predictor(
+        &self,
+        ctx: &IncrementContext<'_>,
+        t_new: f64,
+        x: &mut [f64],
+        linear: &mut FaerLu,
+        times: &mut PhaseTimes,
+    ) -> Result<()> {
+        let jumps: Vec<(usize, f64)> = self
+            .model
+            .dirichlet
+            .iter()
+            .filter(|bc| bc.value.value(t_new) != bc.value.value(self.time))
+            .flat_map(|bc| {
+                let v = bc.value.value(t_new);
+                bc.nodes.iter().map(move |&n| (3 * n + bc.component, v))
+            })
+            .collect();
+        if jumps.is_empty() {
+            return Ok(());
+        }
+        let mut eval = ctx.evaluate(x, times)?;
+        for &(d, v) in &jumps {
+            eval.residual[d] = x[d] - v;
+        }
+        let ts = Instant::now();
+        let dx = self.newton_step(&eval, linear)?;
+        times.factorization_and_solve += ts.elapsed().as_secs_f64();
+        for (xi, d) in x.iter_mut().zip(&dx) {
+            *xi += d;
+        }
+        Ok(())
     }
 
     fn frozen_frames(&self, t_new: f64) -> Vec<Vec<Option<FrozenFrame>>> {
@@ -570,7 +611,7 @@ impl Simulation {
             e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);
             e.frictional_dissipation[c] += dissipated[c];
         }
-        let element = crate::element::hexahedron(self.model.settings.kinematics);
+        let element = crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
         e.elastic_energy = crate::element::total_strain_energy(
             &self.model.mesh,
             element,
