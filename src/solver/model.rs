@@ -64,6 +64,8 @@ pub struct SolverSettings {
     /// Eliminate the multipliers of single-pair, unconstrained contact nodes before the
     /// linear solve (same Newton iterates, smaller factorization; see `condense`).
     pub eliminate_multipliers: bool,
+    /// Increment control, line search, anti-cycling and rollback depth.
+    pub stepping: super::step_control::StepSettings,
 }
 
 impl Default for SolverSettings {
@@ -78,6 +80,7 @@ impl Default for SolverSettings {
             max_cutbacks: 4,
             contact: ContactSettings::default(),
             eliminate_multipliers: true,
+            stepping: Default::default(),
         }
     }
 }
