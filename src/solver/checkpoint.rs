@@ -77,13 +77,13 @@ pub struct Checkpoint {
     pub tool_translations: Vec<[f64; 3]>,
     pub state: SavedState,
     pub history: Vec<IncrementReport>,
-    /// VTK frames the run had written when the checkpoint was taken.
-    pub frames: usize,
+    /// Times of the VTK frames the run had written when the checkpoint was taken.
+    pub frame_times: Vec<f64>,
 }
 
 impl Checkpoint {
     /// The committed state of `sim`.
-    pub fn of(sim: &Simulation, frames: usize) -> Self {
+    pub fn of(sim: &Simulation, frame_times: Vec<f64>) -> Self {
         let state = sim.saved_state();
         Checkpoint {
             format: FORMAT.into(),
@@ -100,7 +100,7 @@ impl Checkpoint {
                 .collect(),
             history: sim.history.clone(),
             state,
-            frames,
+            frame_times,
         }
     }
 

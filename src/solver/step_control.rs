@@ -192,7 +192,7 @@ impl IncrementMeasures {
                 m.plastic_strain = dp;
                 m.plastic_point = i;
             }
-            let angle = incremental_rotation(&old.deformation_gradient, &new.deformation_gradient);
+            let angle = rotation_increment(&old.deformation_gradient, &new.deformation_gradient);
             if angle > m.rotation {
                 m.rotation = angle;
                 m.rotation_point = i;
@@ -227,6 +227,22 @@ impl IncrementMeasures {
             }
         }
         best
+    }
+}
+
+/// Rotation increment (radians) at an integration point: the polar rotation angle of
+/// f = F_new F_old^-1 where both gradients are well inside the physical range
+/// (det F >= 1/2), else the infinitesimal rotation |axial(skew(F_new - F_old))|, which
+/// equals it to first order and stays meaningful (linear in the increment) for the
+/// small-strain elements, whose F = I + grad u is not a true deformation gradient once
+/// grad u is large.
+pub fn rotation_increment(f_old: &crate::geometry::Mat3, f_new: &crate::geometry::Mat3) -> f64 {
+    if f_old.determinant() >= 0.5 && f_new.determinant() >= 0.5 {
+        incremental_rotation(f_old, f_new)
+    } else {
+        let d = f_new - f_old;
+        0.5 * crate::geometry::Vec3::new(d[(2, 1)] - d[(1, 2)], d[(0, 2)] - d[(2, 0)], d[(1, 0)] - d[(0, 1)])
+            .norm()
     }
 }
 
