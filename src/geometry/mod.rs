@@ -34,7 +34,7 @@ pub type Mat3 = Matrix3<f64>;
 
 /// Where on a multi-piece surface a foot point lies (patch index and parameters); used to
 /// warm-start the next projection. Analytic surfaces ignore it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SurfaceHint {
     pub patch: usize,
     pub u: f64,

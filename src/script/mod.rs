@@ -33,6 +33,13 @@ pub struct HostOptions {
     pub defer_run: Rc<std::cell::Cell<bool>>,
     /// Script friction laws by tool name (`tool.friction(|work, slip, pressure| ...)`).
     pub script_laws: Rc<std::cell::RefCell<std::collections::BTreeMap<String, rhai::FnPtr>>>,
+    /// `tribo run --restart FILE`: the first simulation the script starts continues from
+    /// this checkpoint.
+    pub restart: Option<PathBuf>,
+    /// Set once the restart checkpoint has been loaded.
+    pub restart_used: Rc<std::cell::Cell<bool>>,
+    /// Print warnings of converged increments (status cycling, limits exceeded at dt_min).
+    pub warnings: bool,
 }
 
 impl Default for HostOptions {
@@ -43,6 +50,9 @@ impl Default for HostOptions {
             max_operations: 50_000_000,
             defer_run: Rc::new(std::cell::Cell::new(false)),
             script_laws: Rc::default(),
+            restart: None,
+            restart_used: Rc::default(),
+            warnings: true,
         }
     }
 }

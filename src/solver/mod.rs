@@ -1,12 +1,16 @@
 //! Sparse assembly, linear solves, Newton iteration and incremental stepping.
 
 pub mod assembly;
+pub mod checkpoint;
+pub mod cycling;
 pub mod condense;
 pub mod force_control;
 pub mod linear;
 pub mod model;
 pub mod simulation;
 pub mod sparse;
+pub mod step_control;
 
 pub use model::{Model, SolverSettings};
 pub use simulation::{IncrementReport, IterationRecord, Simulation};
+pub use step_control::{AntiCycling, StepMode, StepSettings};

@@ -70,6 +70,8 @@ pub struct SolverSettings {
     /// F-bar volumetric treatment of the finite-strain hexahedron (default on; off gives
     /// the fully integrated element, which locks: for verification only).
     pub fbar: bool,
+    /// Increment control, line search, anti-cycling and rollback depth.
+    pub stepping: super::step_control::StepSettings,
 }
 
 impl Default for SolverSettings {
@@ -86,6 +88,7 @@ impl Default for SolverSettings {
             eliminate_multipliers: true,
             kinematics: crate::element::StrainTheory::Small,
             fbar: true,
+            stepping: Default::default(),
         }
     }
 }
