@@ -122,7 +122,7 @@ pub fn nice_ticks(lo: f64, hi: f64, max_intervals: usize) -> (Vec<f64>, f64) {
 /// Tick label: as many decimals as the step needs, exponent form for extreme magnitudes.
 pub fn tick_label(v: f64, step: f64) -> String {
     let scale = v.abs().max(step);
-    if scale >= 1e6 || scale < 1e-4 {
+    if !(1e-4..1e6).contains(&scale) {
         let digits = ((scale.log10().floor() - step.log10().floor()) as usize).min(6);
         return format!("{v:.digits$e}");
     }

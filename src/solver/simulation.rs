@@ -407,10 +407,14 @@ impl Simulation {
                     rec.force_rel, contact
                 )));
             }
-            if iterations >= 4
-                && residuals.len() >= 2
-                && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30)
-            {
+            // Growth is measured from the first non-zero residual: an increment driven only
+            // by a force-controlled tool starts from zero force residual.
+            let first = residuals
+                .iter()
+                .map(|r| r.force_rel)
+                .find(|&v| v > 0.0)
+                .unwrap_or(1e-30);
+            if iterations >= 4 && residuals.len() >= 2 && rec.force_rel > 1e6 * first {
                 return Err(Error::NoConvergence(format!(
                     "Newton diverges (force residual grew to {:.3e} relative)",
                     rec.force_rel
