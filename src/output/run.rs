@@ -286,6 +286,7 @@ pub fn frame(sim: &Simulation) -> Frame {
         cell_data: vec![
             Field::new("stress", 6, stress),
             Field::scalar("von_mises", von_mises),
+            Field::scalar("equivalent_plastic_strain", eq_plastic),
         ],
     }
 }
