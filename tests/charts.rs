@@ -54,6 +54,7 @@ sim.chart_field("charts/work_top.svg", "z+", "frictional_work", #{ title: "Frict
 sim.chart_field("charts/mu_top.svg", "z+", "mu", #{ range: [0.0, 0.3], configuration: "reference" });
 sim.chart_field("charts/uz.svg", "z+", "displacement_z");
 sim.chart_field("charts/vm.svg", "z-", "von_mises");
+sim.chart_field("charts/epsp.svg", "z+", "equivalent_plastic_strain", #{ range: [0, 0.1] });
 sim.summary("draw_in", [#{ punch_travel: 15, dx: 1.5, dd: () }]);
 sim.summary("holder_offset_max", s[s.len() - 1]);
 "#,
@@ -67,7 +68,7 @@ sim.summary("holder_offset_max", s[s.len() - 1]);
         1 + 4,
         "header and one row per increment"
     );
-    for name in ["work_top", "mu_top", "uz", "vm"] {
+    for name in ["work_top", "mu_top", "uz", "vm", "epsp"] {
         let svg = read(&out.join(format!("charts/{name}.svg")));
         assert!(svg.starts_with("<?xml") && svg.trim_end().ends_with("</svg>"));
         let csv = read(&out.join(format!("charts/{name}.csv")));

@@ -122,7 +122,7 @@ pub fn nice_ticks(lo: f64, hi: f64, max_intervals: usize) -> (Vec<f64>, f64) {
 /// Tick label: as many decimals as the step needs, exponent form for extreme magnitudes.
 pub fn tick_label(v: f64, step: f64) -> String {
     let scale = v.abs().max(step);
-    if scale >= 1e6 || scale < 1e-4 {
+    if !(1e-4..1e6).contains(&scale) {
         let digits = ((scale.log10().floor() - step.log10().floor()) as usize).min(6);
         return format!("{v:.digits$e}");
     }
@@ -471,9 +471,11 @@ impl FieldMap {
         // Equal scales in x and y, the drawing fitted in a 520 x 520 box.
         let scale = 520.0 / (bx1 - bx0).max(by1 - by0);
         let (pw, ph) = ((bx1 - bx0) * scale, (by1 - by0) * scale);
-        let (left, top) = (70.0, 60.0);
+        // A thin strip is centred beside a colour bar of at least 150 px.
+        let (left, bar_top, bar_h) = (70.0, 60.0, ph.max(150.0));
+        let top = bar_top + 0.5 * (bar_h - ph);
         let width = left + pw + 150.0;
-        let height = top + ph.max(200.0) + 50.0;
+        let height = bar_top + bar_h + 50.0;
         let sx = |x: f64| left + (x - bx0) * scale;
         let sy = |y: f64| top + (by1 - y) * scale;
 
@@ -547,7 +549,7 @@ impl FieldMap {
             "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#333\" stroke-width=\"0.8\"/>",
             px(left), px(top), px(pw), px(ph)
         );
-        let (xt, xs) = nice_ticks(bx0, bx1, 6);
+        let (xt, xs) = nice_ticks(bx0, bx1, ((pw / 60.0) as usize).clamp(1, 6));
         for t in xt {
             let _ = writeln!(
                 out,
@@ -566,7 +568,7 @@ impl FieldMap {
                 &tick_label(t, xs),
             );
         }
-        let (yt, ys) = nice_ticks(by0, by1, 6);
+        let (yt, ys) = nice_ticks(by0, by1, ((ph / 40.0) as usize).clamp(1, 6));
         for t in yt {
             let _ = writeln!(
                 out,
@@ -603,7 +605,7 @@ impl FieldMap {
             "",
             "y",
         );
-        self.colour_bar(&mut out, left + pw + 30.0, top, ph.max(200.0));
+        self.colour_bar(&mut out, left + pw + 30.0, bar_top, bar_h);
         out.push_str("</svg>\n");
         Ok(out)
     }

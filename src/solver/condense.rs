@@ -20,7 +20,15 @@
 //! and the row is plain equilibrium; in stick M = 0 and it is the kinematic constraint.)
 //! The reduced system has the displacement unknowns plus the multipliers that stay: pairs
 //! at nodes with a prescribed component or with several pairs (a node that two tools may
-//! touch), and all pairs of a force-controlled tool (its force row couples them). Cost: O(nnz) per iteration to build; the factorization shrinks by the number of
+//! touch).
+//!
+//! A force-controlled tool adds an offset unknown `s` (see `force_control`): its column
+//! enters R1 as `E_s ds` and R2 as `(E_s / r) ds`, which cancel in `R1 - r R2`, so `dl`
+//! keeps the form above and node a's condensed row gains `E_s ds`. The tool's force row
+//! `sum_k c_k . dl_k = -R_s` is kept, with `dl_k` substituted: it gains `-c_k K_k` on the
+//! displacement columns around each eliminated node k.
+//!
+//! Cost: O(nnz) per iteration to build; the factorization shrinks by the number of
 //! eliminated multipliers.
 
 use super::assembly::DofMap;
@@ -51,6 +59,8 @@ pub struct Condenser {
     rows: Vec<Vec<(usize, usize)>>,
     /// Rows of eliminated nodes' equilibrium equations (full index), to skip when copying.
     condensed_row: Vec<bool>,
+    /// Eliminated multiplier dof -> (index in `eliminated`, component).
+    owner: Vec<Option<(usize, usize)>>,
     /// Number of displacement unknowns (they come first).
     n_u: usize,
 }
@@ -72,8 +82,7 @@ impl Condenser {
         }
         let mut eliminated = Vec::new();
         for (c, contact) in model.contacts.iter().enumerate() {
-            // A force-controlled tool's row couples all its multipliers: they stay.
-            let Some(off) = dofs.lambda_offset[c].filter(|_| dofs.tool_offset[c].is_none()) else {
+            let Some(off) = dofs.lambda_offset[c] else {
                 continue;
             };
             for (k, &node) in contact.candidates.iter().enumerate() {
@@ -92,9 +101,11 @@ impl Condenser {
         }
         let mut gone = vec![false; full.n];
         let mut condensed_row = vec![false; full.n];
-        for e in &eliminated {
+        let mut owner = vec![None; full.n];
+        for (index, e) in eliminated.iter().enumerate() {
             for i in 0..3 {
                 gone[e.lambda + i] = true;
+                owner[e.lambda + i] = Some((index, i));
                 condensed_row[3 * e.node + i] = true;
             }
         }
@@ -117,7 +128,24 @@ impl Condenser {
                 }
             }
         }
+        // A kept row with an eliminated column (the force row of a force-controlled tool)
+        // receives the substitution dl = rhs1 - K_a du: the pattern of K_a's row.
+        for (r, row) in rows.iter().enumerate() {
+            let (Some(ri), false) = (reduced_index[r], condensed_row[r]) else {
+                continue;
+            };
+            for &(c, _) in row {
+                if let Some((index, beta)) = owner[c] {
+                    for &(col, _) in &rows[3 * eliminated[index].node + beta] {
+                        if let Some(ci) = reduced_index[col] {
+                            entries.push((ri, ci));
+                        }
+                    }
+                }
+            }
+        }
         Some(Condenser {
+            owner,
             n_u,
             eliminated,
             reduced_index,
@@ -129,6 +157,30 @@ impl Condenser {
 
     pub fn eliminated_count(&self) -> usize {
         3 * self.eliminated.len()
+    }
+
+    /// Adds `factor * K_a[beta]` to reduced row `ri`: K_a is the equilibrium row of the
+    /// eliminated node minus r times its multiplier row (which removes the contact block
+    /// E_x and a tool offset's column E_s, leaving the element stiffness).
+    fn add_k_row(
+        &self,
+        a: &mut SparseMatrix,
+        j: &SparseMatrix,
+        ri: usize,
+        e: &Eliminated,
+        beta: usize,
+        factor: f64,
+    ) {
+        for &(col, k) in &self.rows[3 * e.node + beta] {
+            if let Some(ci) = self.reduced_index[col] {
+                a.add(ri, ci, factor * j.values[k]);
+            }
+        }
+        for &(col, k) in &self.rows[e.lambda + beta] {
+            if let Some(ci) = self.reduced_index[col] {
+                a.add(ri, ci, -factor * e.r * j.values[k]);
+            }
+        }
     }
 
     /// Solves `J dx = -residual` through the reduced system; returns the full dx.
@@ -153,19 +205,23 @@ impl Condenser {
             for &(col, k) in &self.rows[row] {
                 if let Some(ci) = self.reduced_index[col] {
                     a.add(ri, ci, j.values[k]);
+                } else if let Some((index, beta)) = self.owner[col] {
+                    // c dl_beta with dl_beta = rhs1_beta - K_a[beta] du.
+                    let e = &self.eliminated[index];
+                    let (ua, l, c) = (3 * e.node, e.lambda, j.values[k]);
+                    rhs[ri] -= c * (-residual[ua + beta] + e.r * residual[l + beta]);
+                    self.add_k_row(&mut a, j, ri, e, beta, -c);
                 }
             }
         }
-        // Condensed rows: (E_x e_a + M K_a) du = -r R_l + M (-R_u,a + r R_l).
+        // Condensed rows: (E_x e_a + M K_a) du + E_s ds = -r R_l + M (-R_u,a + r R_l).
         let at = |r: usize, c: usize| j.pattern.position(r, c).map_or(0.0, |k| j.values[k]);
         for e in &self.eliminated {
             let (ua, l, r) = (3 * e.node, e.lambda, e.r);
             let mut m = [[0.0; 3]; 3];
-            let mut ex = [[0.0; 3]; 3];
             for (alpha, m_row) in m.iter_mut().enumerate() {
                 for (beta, m_ab) in m_row.iter_mut().enumerate() {
                     *m_ab = f64::from(u8::from(alpha == beta)) - at(ua + alpha, l + beta);
-                    ex[alpha][beta] = r * at(l + alpha, ua + beta);
                 }
             }
             let rhs1: Vec<f64> = (0..3)
@@ -176,19 +232,13 @@ impl Condenser {
                 rhs[ri] =
                     -r * residual[l + alpha] + (0..3).map(|b| m[alpha][b] * rhs1[b]).sum::<f64>();
                 for beta in 0..3 {
-                    // K_a: the equilibrium row without the contact block E_x.
-                    for &(col, k) in &self.rows[ua + beta] {
-                        let Some(ci) = self.reduced_index[col] else {
-                            continue;
-                        };
-                        let mut kv = j.values[k];
-                        if col >= ua && col < ua + 3 {
-                            kv -= ex[beta][col - ua];
-                        }
-                        a.add(ri, ci, m[alpha][beta] * kv);
+                    self.add_k_row(&mut a, j, ri, e, beta, m[alpha][beta]);
+                }
+                // r S: E_x on the node's own displacements (and E_s on a tool offset).
+                for &(col, k) in &self.rows[l + alpha] {
+                    if let Some(ci) = self.reduced_index[col] {
+                        a.add(ri, ci, r * j.values[k]);
                     }
-                    let ci = self.reduced_index[ua + beta].expect("displacements stay");
-                    a.add(ri, ci, ex[alpha][beta]);
                 }
             }
         }

@@ -31,8 +31,10 @@
 //! takes over. If no node lies ahead along the axis the solve stops with an error naming
 //! the tool.
 //!
-//! The multipliers of a force-controlled tool are not condensed out (see `condense`): the
-//! row `R_s` couples them all.
+//! The multipliers of a force-controlled tool are condensed out like the others (see
+//! `condense`): each node's multiplier equations still give `dl = rhs1 - K_a du` (the `s`
+//! terms cancel in `R1 - r R2` because `dF_suppl/ds = (dF_equi/ds) / r`), and the force row
+//! receives that substitution.
 
 use super::assembly::DofMap;
 use super::model::Model;

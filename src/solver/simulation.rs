@@ -701,14 +701,20 @@ impl Simulation {
                     cycling_note()
                 )));
             }
+            // Growth is measured from the first non-zero residual: an increment driven only
+            // by a force-controlled tool starts from zero force residual.
+            let first = residuals
+                .iter()
+                .map(|r| r.force_rel)
+                .find(|&v| v > 0.0)
+                .unwrap_or(1e-30);
+            let first_merit = merits.iter().copied().find(|&v| v > 0.0).unwrap_or(0.0);
             let grew = merits.len() > DIVERGENCE_ITERATIONS
                 && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
                     .windows(2)
                     .all(|w| w[1] > w[0])
-                && merit > merits[0];
-            if grew
-                || (iterations >= 4 && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30))
-            {
+                && merit > first_merit;
+            if grew || (iterations >= 4 && rec.force_rel > 1e6 * first) {
                 return Err(Error::NoConvergence(format!(
                     "Newton diverges (force residual grew to {:.3e} relative); {}{}",
                     rec.force_rel,
