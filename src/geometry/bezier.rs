@@ -412,10 +412,11 @@ impl BezierPatch {
     }
 
     /// Piece of a torus around the axis through `center` along `axis`: major radius `major`
-    /// (centre circle), minor radius `minor` (tube; it may exceed `major` if the patch keeps off the axis). `u` runs around the axis from
-    /// `major_angles[0]` (measured from `reference`) over `major_angles[1]`; `v` runs around
-    /// the tube from `minor_angles[0]` over `minor_angles[1]`, the minor angle `phi`
-    /// measured from the outward radial direction towards `axis`. Sweeps in (0, 120°].
+    /// (centre circle), minor radius `minor` (tube; it may exceed `major` if the patch keeps
+    /// off the axis). `u` runs around the axis from `major_angles[0]` (measured from
+    /// `reference`) over `major_angles[1]`; `v` runs around the tube from `minor_angles[0]`
+    /// over `minor_angles[1]`, the minor angle `phi` measured from the outward radial
+    /// direction towards `axis`. Sweeps in (0, 120°].
     /// Degree 2 x 2, weights `w_i w_j` of the two arcs: the surface of revolution of an
     /// exact circle. The normal points out of the tube.
     pub fn torus_patch(

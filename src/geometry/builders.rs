@@ -255,31 +255,29 @@ pub fn punch_patches(spec: &PunchSpec, extent: Extent) -> Result<Vec<BezierPatch
     let length = k - y0;
     let mut q = flat_inside(half - rn, rc - rn, y0, z0, -1.0)?;
     // Nose radius along the sides: from -z round to the outward side normal.
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(half - rn, k, z0 + rn),
         -Vec3::y(),
         -Vec3::z(),
         0.0,
-        FRAC_PI_2,
         rn,
         length,
     )?);
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(y0, half - rn, z0 + rn),
         Vec3::x(),
         -Vec3::z(),
         0.0,
-        FRAC_PI_2,
         rn,
         length,
     )?);
     // Nose radius at the plan corner: the outer lower quarter of the tube.
-    q.push(BezierPatch::torus_patch(
+    q.push(BezierPatch::quarter_torus(
         Vec3::new(k, k, z0 + rn),
         Vec3::z(),
         Vec3::x(),
-        [0.0, FRAC_PI_2],
-        [-FRAC_PI_2, FRAC_PI_2],
+        0.0,
+        -FRAC_PI_2,
         rc - rn,
         rn,
     )?);
@@ -300,12 +298,11 @@ pub fn punch_patches(spec: &PunchSpec, extent: Extent) -> Result<Vec<BezierPatch
         )?
         .oriented(&Vec3::y()),
     );
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(k, k, top),
         Vec3::z(),
         Vec3::x(),
         0.0,
-        FRAC_PI_2,
         rc,
         wall_height,
     )?);
@@ -337,32 +334,30 @@ pub fn die_patches(spec: &DieSpec, extent: Extent) -> Result<Vec<BezierPatch>> {
     let length = k - y0;
     let mut q = flat_outside(half + re, rc + re, flat_extent, y0, z0, 1.0)?;
     // Entry radius along the sides: from the opening (-x or -y) round to +z.
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(half + re, y0, z0 - re),
         Vec3::y(),
         -Vec3::x(),
         0.0,
-        FRAC_PI_2,
         re,
         length,
     )?);
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(k, half + re, z0 - re),
         -Vec3::x(),
         -Vec3::y(),
         0.0,
-        FRAC_PI_2,
         re,
         length,
     )?);
     // Entry radius at the plan corner: the inner (saddle) upper quarter of the tube,
     // minor angle from +z (90°) to towards the axis (180°).
-    q.push(BezierPatch::torus_patch(
+    q.push(BezierPatch::quarter_torus(
         Vec3::new(k, k, z0 - re),
         Vec3::z(),
         Vec3::x(),
-        [0.0, FRAC_PI_2],
-        [FRAC_PI_2, FRAC_PI_2],
+        0.0,
+        FRAC_PI_2,
         rc + re,
         re,
     )?);
@@ -385,12 +380,11 @@ pub fn die_patches(spec: &DieSpec, extent: Extent) -> Result<Vec<BezierPatch>> {
     );
     // The opening's corner wall faces its axis.
     q.push(
-        BezierPatch::cylinder_patch(
+        BezierPatch::quarter_cylinder(
             Vec3::new(k, k, bottom),
             Vec3::z(),
             Vec3::x(),
             0.0,
-            FRAC_PI_2,
             rc,
             wall_depth,
         )?
