@@ -102,6 +102,48 @@ pub struct BlankholderSpec {
     pub level: f64,
 }
 
+impl PunchSpec {
+    /// NUMISHEET'93 square cup punch (side 70, plan corner 10, nose radius 8, mm) with 50 mm
+    /// of wall, nose at `z = thickness` (on a sheet lying on `z = 0`).
+    pub fn numisheet93(thickness: f64) -> PunchSpec {
+        PunchSpec {
+            side: 70.0,
+            plan_corner_radius: 10.0,
+            nose_radius: 8.0,
+            wall_height: 50.0,
+            level: thickness,
+        }
+    }
+}
+
+impl DieSpec {
+    /// NUMISHEET'93 die (opening 74, plan corner 12, entry radius 8, mm), top at `z = 0`,
+    /// flat to 80 mm from the centre (the blank's half side is 75), 50 mm of wall.
+    pub fn numisheet93() -> DieSpec {
+        DieSpec {
+            opening_side: 74.0,
+            plan_corner_radius: 12.0,
+            entry_radius: 8.0,
+            flat_extent: 80.0,
+            wall_depth: 50.0,
+            level: 0.0,
+        }
+    }
+}
+
+impl BlankholderSpec {
+    /// Blankholder over the NUMISHEET'93 die's flat top: opening 74 + 2 x 8 = 90 with plan
+    /// corner 12 + 8 = 20 (where the entry radius ends), face at `z = thickness`.
+    pub fn numisheet93(thickness: f64) -> BlankholderSpec {
+        BlankholderSpec {
+            opening_side: 90.0,
+            plan_corner_radius: 20.0,
+            flat_extent: 80.0,
+            level: thickness,
+        }
+    }
+}
+
 fn finite(what: &str, v: f64) -> Result<f64> {
     if v.is_finite() {
         Ok(v)
