@@ -16,14 +16,7 @@ fn main() {
         .nth(1)
         .map(|s| s.parse().expect("NODES must be a number"))
         .unwrap_or(100_000);
-    let spec = DieSpec {
-        opening_side: 74.0,
-        plan_corner_radius: 12.0,
-        entry_radius: 8.0,
-        flat_extent: 80.0,
-        wall_depth: 50.0,
-        level: 0.0,
-    };
+    let spec = DieSpec::numisheet93();
     let mut seed = 12345u64;
     let mut uniform = |lo: f64, hi: f64| {
         seed ^= seed << 13;

@@ -17,24 +17,11 @@ use tribo::geometry::{PatchSurface, RigidSurface, Vec3};
 const T: f64 = 0.81;
 
 fn punch_spec() -> PunchSpec {
-    PunchSpec {
-        side: 70.0,
-        plan_corner_radius: 10.0,
-        nose_radius: 8.0,
-        wall_height: 50.0,
-        level: T,
-    }
+    PunchSpec::numisheet93(T)
 }
 
 fn die_spec() -> DieSpec {
-    DieSpec {
-        opening_side: 74.0,
-        plan_corner_radius: 12.0,
-        entry_radius: 8.0,
-        flat_extent: 80.0,
-        wall_depth: 50.0,
-        level: 0.0,
-    }
+    DieSpec::numisheet93()
 }
 
 /// Signed distance from plan point `(x, y)` to the rounded square RS(h, r) (< 0 inside).
@@ -179,12 +166,7 @@ fn die_is_the_exact_die_with_rounded_square_opening() {
 
 #[test]
 fn blankholder_is_flat_with_its_opening() {
-    let spec = BlankholderSpec {
-        opening_side: 90.0,
-        plan_corner_radius: 20.0,
-        flat_extent: 80.0,
-        level: T,
-    };
+    let spec = BlankholderSpec::numisheet93(T);
     let surface = PatchSurface::new(blankholder_patches(&spec, Extent::Full).unwrap()).unwrap();
     assert!(surface.seams().worst_kink < 1e-12 && surface.seams().worst_gap < 1e-12);
     let mut rng = Rng(13);

@@ -213,7 +213,50 @@ impl BezierPatch {
                 "must be > 0: the patch is degenerate (control points coincide or lie on a curve)",
             ));
         }
+        patch.check_no_fold(samples)?;
         Ok(patch)
+    }
+
+    /// A patch that folds over itself has a part facing inward: its area element
+    /// `S_u x S_v` reverses between neighbouring samples of a `samples`-cell grid (a turn of
+    /// more than 90° between samples; a smooth patch turns by far less: a 120° arc sampled
+    /// in 6 cells turns 20° per cell). Poles (no normal) are skipped.
+    fn check_no_fold(&self, samples: usize) -> Result<()> {
+        let n = samples as f64;
+        let normal_at = |a: usize, b: usize| {
+            let e = self.evaluate(a as f64 / n, b as f64 / n);
+            self.normal(&e)
+        };
+        let grid: Vec<Vec<Option<Vec3>>> = (0..=samples)
+            .map(|a| (0..=samples).map(|b| normal_at(a, b)).collect())
+            .collect();
+        for a in 0..=samples {
+            for b in 0..=samples {
+                let here = grid[a][b];
+                for (c, d) in [(a + 1, b), (a, b + 1)] {
+                    if c > samples || d > samples {
+                        continue;
+                    }
+                    if let (Some(p), Some(q)) = (here, grid[c][d]) {
+                        if p.dot(&q) < 0.0 {
+                            return Err(Error::input(
+                                "bezier patch normal",
+                                format!(
+                                    "reversal between (u, v) = ({:.3}, {:.3}) and ({:.3}, {:.3})",
+                                    a as f64 / n,
+                                    b as f64 / n,
+                                    c as f64 / n,
+                                    d as f64 / n
+                                ),
+                                "is refused: the patch folds over itself, so part of it faces \
+                                 inward (check the order of its control points)",
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The same patch with the opposite outward normal.
@@ -412,10 +455,11 @@ impl BezierPatch {
     }
 
     /// Piece of a torus around the axis through `center` along `axis`: major radius `major`
-    /// (centre circle), minor radius `minor` (tube; it may exceed `major` if the patch keeps off the axis). `u` runs around the axis from
-    /// `major_angles[0]` (measured from `reference`) over `major_angles[1]`; `v` runs around
-    /// the tube from `minor_angles[0]` over `minor_angles[1]`, the minor angle `phi`
-    /// measured from the outward radial direction towards `axis`. Sweeps in (0, 120°].
+    /// (centre circle), minor radius `minor` (tube; it may exceed `major` if the patch keeps
+    /// off the axis). `u` runs around the axis from `major_angles[0]` (measured from
+    /// `reference`) over `major_angles[1]`; `v` runs around the tube from `minor_angles[0]`
+    /// over `minor_angles[1]`, the minor angle `phi` measured from the outward radial
+    /// direction towards `axis`. Sweeps in (0, 120°].
     /// Degree 2 x 2, weights `w_i w_j` of the two arcs: the surface of revolution of an
     /// exact circle. The normal points out of the tube.
     pub fn torus_patch(
@@ -708,6 +752,18 @@ mod tests {
         let p = Vec3::new(1.0, 2.0, 3.0);
         let err = msg(BezierPatch::new(1, 1, vec![p; 4], vec![1.0; 4]));
         assert!(err.contains("the patch is degenerate"), "{err}");
+        // A quadratic-by-linear strip whose middle control row overshoots: the u curve
+        // runs out and back, so the area element reverses halfway.
+        let folded = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(2.0, 1.0, 0.0),
+            Vec3::new(0.5, 0.0, 0.0),
+            Vec3::new(0.5, 1.0, 0.0),
+        ];
+        let err = msg(BezierPatch::new(2, 1, folded, vec![1.0; 6]));
+        assert!(err.contains("the patch folds over itself"), "{err}");
         let grid = vec![
             Vec3::zeros(),
             Vec3::y(),

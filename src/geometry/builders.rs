@@ -102,6 +102,48 @@ pub struct BlankholderSpec {
     pub level: f64,
 }
 
+impl PunchSpec {
+    /// NUMISHEET'93 square cup punch (side 70, plan corner 10, nose radius 8, mm) with 50 mm
+    /// of wall, nose at `z = thickness` (on a sheet lying on `z = 0`).
+    pub fn numisheet93(thickness: f64) -> PunchSpec {
+        PunchSpec {
+            side: 70.0,
+            plan_corner_radius: 10.0,
+            nose_radius: 8.0,
+            wall_height: 50.0,
+            level: thickness,
+        }
+    }
+}
+
+impl DieSpec {
+    /// NUMISHEET'93 die (opening 74, plan corner 12, entry radius 8, mm), top at `z = 0`,
+    /// flat to 80 mm from the centre (the blank's half side is 75), 50 mm of wall.
+    pub fn numisheet93() -> DieSpec {
+        DieSpec {
+            opening_side: 74.0,
+            plan_corner_radius: 12.0,
+            entry_radius: 8.0,
+            flat_extent: 80.0,
+            wall_depth: 50.0,
+            level: 0.0,
+        }
+    }
+}
+
+impl BlankholderSpec {
+    /// Blankholder over the NUMISHEET'93 die's flat top: opening 74 + 2 x 8 = 90 with plan
+    /// corner 12 + 8 = 20 (where the entry radius ends), face at `z = thickness`.
+    pub fn numisheet93(thickness: f64) -> BlankholderSpec {
+        BlankholderSpec {
+            opening_side: 90.0,
+            plan_corner_radius: 20.0,
+            flat_extent: 80.0,
+            level: thickness,
+        }
+    }
+}
+
 fn finite(what: &str, v: f64) -> Result<f64> {
     if v.is_finite() {
         Ok(v)
@@ -255,31 +297,29 @@ pub fn punch_patches(spec: &PunchSpec, extent: Extent) -> Result<Vec<BezierPatch
     let length = k - y0;
     let mut q = flat_inside(half - rn, rc - rn, y0, z0, -1.0)?;
     // Nose radius along the sides: from -z round to the outward side normal.
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(half - rn, k, z0 + rn),
         -Vec3::y(),
         -Vec3::z(),
         0.0,
-        FRAC_PI_2,
         rn,
         length,
     )?);
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(y0, half - rn, z0 + rn),
         Vec3::x(),
         -Vec3::z(),
         0.0,
-        FRAC_PI_2,
         rn,
         length,
     )?);
     // Nose radius at the plan corner: the outer lower quarter of the tube.
-    q.push(BezierPatch::torus_patch(
+    q.push(BezierPatch::quarter_torus(
         Vec3::new(k, k, z0 + rn),
         Vec3::z(),
         Vec3::x(),
-        [0.0, FRAC_PI_2],
-        [-FRAC_PI_2, FRAC_PI_2],
+        0.0,
+        -FRAC_PI_2,
         rc - rn,
         rn,
     )?);
@@ -300,12 +340,11 @@ pub fn punch_patches(spec: &PunchSpec, extent: Extent) -> Result<Vec<BezierPatch
         )?
         .oriented(&Vec3::y()),
     );
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(k, k, top),
         Vec3::z(),
         Vec3::x(),
         0.0,
-        FRAC_PI_2,
         rc,
         wall_height,
     )?);
@@ -337,32 +376,30 @@ pub fn die_patches(spec: &DieSpec, extent: Extent) -> Result<Vec<BezierPatch>> {
     let length = k - y0;
     let mut q = flat_outside(half + re, rc + re, flat_extent, y0, z0, 1.0)?;
     // Entry radius along the sides: from the opening (-x or -y) round to +z.
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(half + re, y0, z0 - re),
         Vec3::y(),
         -Vec3::x(),
         0.0,
-        FRAC_PI_2,
         re,
         length,
     )?);
-    q.push(BezierPatch::cylinder_patch(
+    q.push(BezierPatch::quarter_cylinder(
         Vec3::new(k, half + re, z0 - re),
         -Vec3::x(),
         -Vec3::y(),
         0.0,
-        FRAC_PI_2,
         re,
         length,
     )?);
     // Entry radius at the plan corner: the inner (saddle) upper quarter of the tube,
     // minor angle from +z (90°) to towards the axis (180°).
-    q.push(BezierPatch::torus_patch(
+    q.push(BezierPatch::quarter_torus(
         Vec3::new(k, k, z0 - re),
         Vec3::z(),
         Vec3::x(),
-        [0.0, FRAC_PI_2],
-        [FRAC_PI_2, FRAC_PI_2],
+        0.0,
+        FRAC_PI_2,
         rc + re,
         re,
     )?);
@@ -385,12 +422,11 @@ pub fn die_patches(spec: &DieSpec, extent: Extent) -> Result<Vec<BezierPatch>> {
     );
     // The opening's corner wall faces its axis.
     q.push(
-        BezierPatch::cylinder_patch(
+        BezierPatch::quarter_cylinder(
             Vec3::new(k, k, bottom),
             Vec3::z(),
             Vec3::x(),
             0.0,
-            FRAC_PI_2,
             rc,
             wall_depth,
         )?
