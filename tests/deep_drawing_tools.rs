@@ -185,6 +185,25 @@ fn blankholder_is_flat_with_its_opening() {
         checked += 1;
     }
     assert!(checked > 1000);
+    // Over the opening the rounded edge keeps the sheet outside the holder, even at or above
+    // the face level (an open, sharp edge would judge such a point inside): the gap is the
+    // distance to the edge's torus/cylinder, whose tube centre line is 5 mm above the face at
+    // the flat's boundary (half side 45, plan corner 20).
+    for (x, y, z) in [
+        (42.0, 0.0, T),
+        (42.0, 10.0, T + 0.3),
+        (38.0, 38.0, T + 0.2),
+        (0.0, 43.0, T - 0.1),
+    ] {
+        let p = surface.project(&Vec3::new(x, y, z), None).unwrap();
+        let d = rounded_square_sdf(x, y, 45.0, 20.0); // < 0: plan distance inside the boundary
+        let expected = (d * d + (T + 5.0 - z).powi(2)).sqrt() - 5.0;
+        assert!(
+            p.gap > 0.0 && (p.gap - expected).abs() < 1e-9,
+            "({x}, {y}, {z}): gap {} expected {expected}",
+            p.gap
+        );
+    }
 }
 
 /// The bounding-volume hierarchy only prunes: projections with and without it agree (foot,

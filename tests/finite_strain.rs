@@ -123,9 +123,8 @@ fn uniaxial_tension_to_50_percent_follows_the_swift_curve() {
 /// its own tangent nowhere here). Returns the committed state after each of `steps`
 /// increments to `eps_max`.
 fn uniaxial_point(m: &dyn Material, eps_max: f64, steps: usize) -> Vec<PointState> {
-    let sym = |y: &[f64; 5], uxx: f64| {
-        Mat3::new(uxx, y[2], y[4], y[2], y[0], y[3], y[4], y[3], y[1])
-    };
+    let sym =
+        |y: &[f64; 5], uxx: f64| Mat3::new(uxx, y[2], y[4], y[2], y[0], y[3], y[4], y[3], y[1]);
     let rows = |s: &tribo::material::Voigt| [s[1], s[2], s[3], s[4], s[5]];
     let mut committed = m.initial_state();
     let mut y = [1.0, 1.0, 0.0, 0.0, 0.0];
@@ -230,8 +229,11 @@ fn rigid_rotation_of_a_plastic_element_is_objective() {
     assert!(before.iter().all(|p| p.eq_plastic_strain > 0.01));
     let axis = nalgebra::Unit::new_normalize(Vec3::new(1.0, 2.0, -0.5));
     for k in 1..=10 {
-        let r = nalgebra::Rotation3::from_axis_angle(&axis, std::f64::consts::FRAC_PI_2 * k as f64 / 10.0)
-            .into_inner();
+        let r = nalgebra::Rotation3::from_axis_angle(
+            &axis,
+            std::f64::consts::FRAC_PI_2 * k as f64 / 10.0,
+        )
+        .into_inner();
         let u: [Vec3; 8] = std::array::from_fn(|a| r * (x[a] + pre[a]) - x[a]);
         el.evaluate(&x, &u, &committed, &mut trial, &m).unwrap();
         committed = trial;
@@ -242,7 +244,9 @@ fn rigid_rotation_of_a_plastic_element_is_objective() {
             for (a, b) in invariants(&p.stress).iter().zip(invariants(&p0.stress)) {
                 assert!((a - b).abs() <= 1e-8 * b.abs().max(scale.powi(3) * 1e-6));
             }
-            assert!((p.eq_plastic_strain - p0.eq_plastic_strain).abs() < 1e-8 * p0.eq_plastic_strain);
+            assert!(
+                (p.eq_plastic_strain - p0.eq_plastic_strain).abs() < 1e-8 * p0.eq_plastic_strain
+            );
         }
     }
 }
@@ -335,7 +339,10 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
     );
     assert!(ep > 0.05, "the strip yields");
     assert!(turn > 0.25, "large rotation");
-    assert!(measured >= 10, "{measured} increments with a measured order");
+    assert!(
+        measured >= 10,
+        "{measured} increments with a measured order"
+    );
     assert!(worst >= 1.8, "observed order {worst}");
     // Support work = stored + dissipated, to the trapezoidal rule's accuracy.
     assert!(e.relative_error.abs() < 1e-3, "{}", e.relative_error);
@@ -402,5 +409,8 @@ fn fbar_does_not_lock_in_nearly_incompressible_plastic_bending() {
     assert!((coarse - reference).abs() < 0.2 * reference);
     assert!((fine - reference).abs() < 0.05 * reference);
     assert!(locked > 5.0 * reference, "8x2 without F-bar: {locked}");
-    assert!(locked_fine > 5.0 * reference, "32x8 without F-bar: {locked_fine}");
+    assert!(
+        locked_fine > 5.0 * reference,
+        "32x8 without F-bar: {locked_fine}"
+    );
 }

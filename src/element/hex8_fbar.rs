@@ -142,11 +142,12 @@ impl Element<DOFS> for Hex8FBar {
         for gp in 0..POINTS {
             let b = &geo.grad[gp];
             let f = gradient(&u, b);
-            let (f_inv_t, j) =
-                inverse_transpose(&f, &format!("integration point {gp}"))?;
+            let (f_inv_t, j) = inverse_transpose(&f, &format!("integration point {gp}"))?;
             let g: [Vec3; NODES] = std::array::from_fn(|a| f_inv_t * b[a]);
             let (r, q) = if self.fbar {
-                let q = SVector::<f64, DOFS>::from_fn(|i, _| (g0[i / 3][i % 3] - g[i / 3][i % 3]) / 3.0);
+                let q = SVector::<f64, DOFS>::from_fn(|i, _| {
+                    (g0[i / 3][i % 3] - g[i / 3][i % 3]) / 3.0
+                });
                 ((j0 / j).cbrt(), q)
             } else {
                 (1.0, SVector::<f64, DOFS>::zeros())
@@ -206,9 +207,8 @@ impl Element<DOFS> for Hex8FBar {
                     for k in 0..3 {
                         for c in 0..NODES {
                             for l in 0..3 {
-                                extra[(3 * a + k, 3 * c + l)] += pf
-                                    * (g[a][l] * g[c][k] - g0[a][l] * g0[c][k])
-                                    / 3.0;
+                                extra[(3 * a + k, 3 * c + l)] +=
+                                    pf * (g[a][l] * g[c][k] - g0[a][l] * g0[c][k]) / 3.0;
                             }
                         }
                     }
@@ -285,7 +285,11 @@ mod tests {
         x: &[Vec3; 8],
         u: &[Vec3; 8],
         m: &dyn Material,
-    ) -> ([PointState; POINTS], ElementResponse<DOFS>, [PointState; POINTS]) {
+    ) -> (
+        [PointState; POINTS],
+        ElementResponse<DOFS>,
+        [PointState; POINTS],
+    ) {
         let half = u.map(|v| v * 0.5);
         let mut committed = [PointState::default(); POINTS];
         let mut trial = committed;

@@ -373,7 +373,10 @@ mod tests {
                     };
                     let fd = (s_at(&(c + dc)) - s_at(&(c - dc))) / (2.0 * h);
                     let err = (fd - resp.tangent.column(n)).amax() / scale;
-                    assert!(err < 1e-6, "material {mi}, column {n}: relative error {err:e}");
+                    assert!(
+                        err < 1e-6,
+                        "material {mi}, column {n}: relative error {err:e}"
+                    );
                 }
             }
         }

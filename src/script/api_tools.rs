@@ -260,6 +260,14 @@ impl Params<'_> {
         }
     }
 
+    /// An optional parameter, `default` when absent.
+    fn get_or(&self, key: &str, default: f64) -> ScriptResult<f64> {
+        match self.map.get(key) {
+            Some(v) => number(v, &format!("{} {key}", self.tool)),
+            None => Ok(default),
+        }
+    }
+
     /// Quarter (`quarter_margin` given) or full tool.
     fn extent(&self) -> ScriptResult<Extent> {
         match self.map.get("quarter_margin") {
@@ -332,6 +340,8 @@ fn register_builders(engine: &mut Engine) {
                 "corner_radius",
                 "flat_extent",
                 "level",
+                "edge_radius",
+                "wall_height",
                 "quarter_margin",
             ])?;
             let spec = BlankholderSpec {
@@ -339,6 +349,8 @@ fn register_builders(engine: &mut Engine) {
                 plan_corner_radius: p.get("corner_radius")?,
                 flat_extent: p.get("flat_extent")?,
                 level: p.get("level")?,
+                edge_radius: p.get_or("edge_radius", 0.0)?,
+                wall_height: p.get_or("wall_height", 20.0)?,
             };
             let patches = lift(blankholder_patches(&spec, p.extent()?))?;
             Ok(surface(lift(PatchSurface::new(patches))?))

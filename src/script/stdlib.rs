@@ -10,7 +10,10 @@ const MODULES: &[(&str, &str)] = &[
     ("testing", include_str!("../../std-lib/testing.rhai")),
     ("scenes", include_str!("../../std-lib/scenes.rhai")),
     ("tools", include_str!("../../std-lib/tools.rhai")),
-    ("numisheet93", include_str!("../../std-lib/numisheet93.rhai")),
+    (
+        "numisheet93",
+        include_str!("../../std-lib/numisheet93.rhai"),
+    ),
 ];
 
 /// Names of the embedded std-lib modules.

@@ -2,8 +2,8 @@
 
 pub mod assembly;
 pub mod checkpoint;
-pub mod cycling;
 pub mod condense;
+pub mod cycling;
 pub mod force_control;
 pub mod linear;
 pub mod model;

@@ -4,13 +4,13 @@
 //! leaves the last converged state untouched.
 
 use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use super::checkpoint::SavedState;
 use super::condense::Condenser;
+use super::cycling::{CyclingMonitor, CyclingNode};
 use super::force_control;
 use super::linear::{FaerLu, LinearSolver};
 use super::model::Model;
-use super::cycling::{CyclingMonitor, CyclingNode};
 use super::sparse::SparsePattern;
-use super::checkpoint::SavedState;
 use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
 use crate::element::{Element, Hex8};
@@ -687,8 +687,8 @@ impl Simulation {
                     "non-finite residual at iteration {iterations}"
                 )));
             }
-            let force_ok =
-                rec.force <= settings.force_rel_tol * reference || rec.force <= settings.force_abs_tol;
+            let force_ok = rec.force <= settings.force_rel_tol * reference
+                || rec.force <= settings.force_abs_tol;
             if force_ok && rec.contact <= settings.contact_tol {
                 break;
             }
@@ -725,8 +725,15 @@ impl Simulation {
             let ts = Instant::now();
             let dx = self.newton_step(&eval, linear)?;
             times.factorization_and_solve += ts.elapsed().as_secs_f64();
-            let (x_new, eval_new, cuts) =
-                self.line_search(&ctx, &x, &dx, merit, monitor.damping(), &weights, &mut times)?;
+            let (x_new, eval_new, cuts) = self.line_search(
+                &ctx,
+                &x,
+                &dx,
+                merit,
+                monitor.damping(),
+                &weights,
+                &mut times,
+            )?;
             line_search_cuts += cuts;
             x = x_new;
             eval = eval_new;
@@ -768,9 +775,8 @@ impl Simulation {
         weights: &[f64],
         times: &mut PhaseTimes,
     ) -> Result<(Vec<f64>, Evaluation, usize)> {
-        let trial_x = |alpha: f64| -> Vec<f64> {
-            x.iter().zip(dx).map(|(xi, d)| xi + alpha * d).collect()
-        };
+        let trial_x =
+            |alpha: f64| -> Vec<f64> { x.iter().zip(dx).map(|(xi, d)| xi + alpha * d).collect() };
         if !self.model.settings.stepping.line_search {
             let xn = trial_x(alpha0);
             let e = ctx.evaluate(&xn, times)?;
@@ -994,7 +1000,8 @@ impl Simulation {
             e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);
             e.frictional_dissipation[c] += dissipated[c];
         }
-        let element = crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
+        let element =
+            crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
         e.elastic_energy = crate::element::total_strain_energy(
             &self.model.mesh,
             element,
@@ -1002,13 +1009,15 @@ impl Simulation {
             self.model.material.as_ref(),
         )
         .unwrap_or(f64::NAN);
-        e.plastic_dissipation =
-            crate::element::total_plastic_dissipation(&self.model.mesh, element, &eval.trial_points)
-                .unwrap_or(f64::NAN);
+        e.plastic_dissipation = crate::element::total_plastic_dissipation(
+            &self.model.mesh,
+            element,
+            &eval.trial_points,
+        )
+        .unwrap_or(f64::NAN);
         let input = e.tool_work + e.load_work + e.support_work;
-        let stored: f64 = e.elastic_energy
-            + e.plastic_dissipation
-            + e.frictional_dissipation.iter().sum::<f64>();
+        let stored: f64 =
+            e.elastic_energy + e.plastic_dissipation + e.frictional_dissipation.iter().sum::<f64>();
         let scale =
             (e.tool_work.abs() + e.load_work.abs() + e.support_work.abs()).max(stored.abs());
         e.relative_error = if scale > 0.0 {
