@@ -72,6 +72,9 @@ pub struct SolverSettings {
     pub fbar: bool,
     /// Increment control, line search, anti-cycling and rollback depth.
     pub stepping: super::step_control::StepSettings,
+    /// Start each increment's Newton iteration from the last increment's change of the
+    /// displacements, scaled to the new step (off: from the committed state).
+    pub extrapolate: bool,
 }
 
 impl Default for SolverSettings {
@@ -89,6 +92,7 @@ impl Default for SolverSettings {
             kinematics: crate::element::StrainTheory::Small,
             fbar: true,
             stepping: Default::default(),
+            extrapolate: false,
         }
     }
 }

@@ -124,6 +124,8 @@ pub struct Simulation {
     stops: Vec<f64>,
     /// Committed states before the last increments, for `rollback`.
     saved: VecDeque<SavedState>,
+    /// Last converged increment (dt, change of the unknowns), for the extrapolating predictor.
+    last_step: Option<(f64, Vec<f64>)>,
 }
 
 impl Simulation {
@@ -203,6 +205,7 @@ impl Simulation {
                 frictional_dissipation: vec![0.0; model.contacts.len()],
                 ..Default::default()
             },
+            last_step: None,
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -651,6 +654,16 @@ impl Simulation {
         let mut monitor = CyclingMonitor::new(&sizes, step.anti_cycling, step.cycle_flips);
         let node_of = |c: usize, k: usize| self.model.contacts[c].candidates[k];
         let mut times = PhaseTimes::default();
+        // The last increment's displacement change, scaled to this step: in forming the
+        // sheet keeps moving the way it moved, so the first iterate starts near the right
+        // contact statuses (from the committed state, Newton has to rediscover the whole
+        // active set, tens of iterations on a drawn sheet).
+        if let (true, Some((dt_last, dx))) = (settings.extrapolate, &self.last_step) {
+            let ratio = (t_new - self.time) / dt_last;
+            for (xi, d) in x[..n_u].iter_mut().zip(&dx[..n_u]) {
+                *xi += ratio * d;
+            }
+        }
         self.dirichlet_predictor(&ctx, t_new, &mut x, linear, &mut times)?;
         for bc in &self.model.dirichlet {
             let v = bc.value.value(t_new);
@@ -946,9 +959,10 @@ impl Simulation {
         let tool_offsets = (0..self.model.contacts.len())
             .map(|c| force_control::offset(&self.dofs, c, &x))
             .collect();
+        let dt = t_new - self.time;
+        self.last_step = Some((dt, x.iter().zip(&self.x).map(|(a, b)| a - b).collect()));
         self.x = x;
         self.points = eval.trial_points;
-        let dt = t_new - self.time;
         self.time = t_new;
         self.increments_done += 1;
         IncrementReport {
