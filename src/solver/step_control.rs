@@ -93,7 +93,7 @@ impl Default for StepSettings {
             growth: 2.0,
             line_search: true,
             anti_cycling: AntiCycling::Freeze,
-            cycle_flips: 4,
+            cycle_flips: 3,
             rollback_depth: 3,
         }
     }
