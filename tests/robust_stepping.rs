@@ -326,3 +326,81 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
     let _ = std::fs::remove_dir_all(&off_dir);
     let _ = std::fs::remove_dir_all(&on_dir);
 }
+
+/// The REPL steps, rolls back to the previous converged increment, switches to adaptive
+/// steps and steps on; history.csv follows the rollback.
+#[test]
+fn repl_rolls_back_and_changes_a_setting_before_stepping_on() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scripts/cylinder_drag.rhai");
+    let out = out_dir("repl-rollback");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .arg("repl")
+        .arg(&script)
+        .arg("--out")
+        .arg(&out)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(
+            b"sim.step(); sim.step(); sim.step();\n\
+              sim.rollback()\n\
+              sim.history().len()\n\
+              sim.settings(#{ step_control: \"adaptive\", dt_max: 0.05 });\n\
+              sim.step(); sim.time\n\
+              sim.rollback(9)\n\
+              :quit\n",
+        )
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    println!("{stdout}");
+    // Three nominal increments of 0.1, back to 0.2, then one adaptive step of 0.05.
+    assert!(lines.iter().any(|l| l.trim() == "0.2"), "{stdout}");
+    assert!(lines.iter().any(|l| l.trim() == "2"), "{stdout}");
+    assert!(
+        lines.iter().any(|l| l.trim().starts_with("0.25")),
+        "{stdout}"
+    );
+    assert!(stdout.contains("cannot roll back 9 increment(s)"), "{stdout}");
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert_eq!(history.lines().count(), 1 + 3, "header + 2 kept + 1 new row");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
+    use std::process::Command;
+    let script = robust_script("restart_drag.rhai");
+    let dir = out_dir("bad-restart");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |ck: &Path| {
+        let out = Command::new(env!("CARGO_BIN_EXE_tribo"))
+            .args(["run", "--quiet", "--restart"])
+            .arg(ck)
+            .arg("--out")
+            .arg(dir.join("out"))
+            .arg(&script)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(!out.status.success() && !stderr.contains("panicked"), "{stderr}");
+        stderr
+    };
+    let err = run(&dir.join("missing.json"));
+    assert!(err.contains("missing.json"), "{err}");
+    let foreign = dir.join("foreign.json");
+    std::fs::write(&foreign, "{\"format\": \"something else\"}").unwrap();
+    let err = run(&foreign);
+    assert!(err.contains("is not a tribo checkpoint"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -647,10 +647,13 @@ impl Simulation {
         let mut iterations = 0;
         let mut line_search_cuts = 0;
         let mut eval = ctx.evaluate(&x, &mut times)?;
+        // Merits before a freeze belong to another problem: divergence is judged after it.
+        let mut window_start = 0;
         loop {
             if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
                 ctx.forced = monitor.forced();
                 eval = ctx.evaluate(&x, &mut times)?;
+                window_start = merits.len();
             }
             let (rec, merit, reference) = self.residual_record(&eval, &weights);
             residuals.push(rec);
@@ -685,7 +688,7 @@ impl Simulation {
                     cycling_note()
                 )));
             }
-            let grew = merits.len() > DIVERGENCE_ITERATIONS
+            let grew = merits.len() > window_start + DIVERGENCE_ITERATIONS
                 && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
                     .windows(2)
                     .all(|w| w[1] > w[0])
