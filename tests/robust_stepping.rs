@@ -32,7 +32,10 @@ fn adaptive_drag() -> tribo::solver::Model {
 
 fn max_difference(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// The checkpoint's JSON holds every f64 exactly, and the restarted run repeats the
@@ -186,7 +189,8 @@ fn scripts_cannot_write_outside_their_output_folder() {
     let err = run_inline("nested", "write_text(\"notes/../../x\", \"hello\");").unwrap_err();
     assert!(err.contains("'..'"), "{err}");
     // Checkpoints go through the same guard.
-    let scene = "let sim = simulation(block([0,0,0],[1,1,1],[1,1,1]), linear_elastic(1000.0, 0.3));\n\
+    let scene =
+        "let sim = simulation(block([0,0,0],[1,1,1],[1,1,1]), linear_elastic(1000.0, 0.3));\n\
                  sim.fix(\"z-\", \"xyz\");\n";
     let err = run_inline("ck", &format!("{scene}sim.checkpoint(\"/tmp/x\");")).unwrap_err();
     assert!(err.contains("absolute paths are refused"), "{err}");
@@ -232,7 +236,12 @@ fn history_column(dir: &Path, name: &str) -> Vec<f64> {
 #[test]
 fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
     let script = robust_script("fast_drag.rhai");
-    let common_sets = ["radius=0.25", "cells=24", "max_iterations=10", "max_cutbacks=0"];
+    let common_sets = [
+        "radius=0.25",
+        "cells=24",
+        "max_iterations=10",
+        "max_cutbacks=0",
+    ];
     let sets = |mode: &str| {
         let mut v: Vec<_> = common_sets
             .iter()
@@ -251,7 +260,10 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
         .unwrap_err()
         .to_string();
     println!("fixed steps: {err}");
-    assert!(err.contains("Newton iterations without convergence"), "{err}");
+    assert!(
+        err.contains("Newton iterations without convergence"),
+        "{err}"
+    );
     assert!(
         err.contains("largest force residual at node(s)"),
         "names the nodes: {err}"
@@ -371,9 +383,16 @@ fn repl_rolls_back_and_changes_a_setting_before_stepping_on() {
         lines.iter().any(|l| l.trim().starts_with("0.25")),
         "{stdout}"
     );
-    assert!(stdout.contains("cannot roll back 9 increment(s)"), "{stdout}");
+    assert!(
+        stdout.contains("cannot roll back 9 increment(s)"),
+        "{stdout}"
+    );
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
-    assert_eq!(history.lines().count(), 1 + 3, "header + 2 kept + 1 new row");
+    assert_eq!(
+        history.lines().count(),
+        1 + 3,
+        "header + 2 kept + 1 new row"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }
 
@@ -393,7 +412,10 @@ fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
             .output()
             .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-        assert!(!out.status.success() && !stderr.contains("panicked"), "{stderr}");
+        assert!(
+            !out.status.success() && !stderr.contains("panicked"),
+            "{stderr}"
+        );
         stderr
     };
     let err = run(&dir.join("missing.json"));

@@ -93,7 +93,8 @@ impl RunOutput {
     /// Writes the committed state as a checkpoint at `relative` (below the output folder).
     pub fn write_checkpoint(&self, sim: &Simulation, relative: &str) -> Result<std::path::PathBuf> {
         let path = self.folder.resolve_for_write(relative)?;
-        let json = crate::solver::checkpoint::Checkpoint::of(sim, self.frame_times.clone()).to_json()?;
+        let json =
+            crate::solver::checkpoint::Checkpoint::of(sim, self.frame_times.clone()).to_json()?;
         super::write_atomic(&path, json.as_bytes())?;
         Ok(path)
     }

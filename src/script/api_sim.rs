@@ -153,7 +153,10 @@ impl SimState {
         let sim = self.sim.as_ref().expect("started");
         if self.host.warnings {
             for w in &report.warnings {
-                eprintln!("warning: increment {} (t = {}): {w}", report.index, report.time);
+                eprintln!(
+                    "warning: increment {} (t = {}): {w}",
+                    report.index, report.time
+                );
             }
         }
         if let Some(out) = self.output.as_mut() {
@@ -670,12 +673,15 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     engine.register_fn("rollback", |s: &mut ScriptSim| -> ScriptResult<f64> {
         rollback(s, 1)
     });
-    engine.register_fn("rollback", |s: &mut ScriptSim, n: i64| -> ScriptResult<f64> {
-        if n < 1 {
-            return runtime_error(format!("rollback({n}): the count must be >= 1"));
-        }
-        rollback(s, n as usize)
-    });
+    engine.register_fn(
+        "rollback",
+        |s: &mut ScriptSim, n: i64| -> ScriptResult<f64> {
+            if n < 1 {
+                return runtime_error(format!("rollback({n}): the count must be >= 1"));
+            }
+            rollback(s, n as usize)
+        },
+    );
     engine.register_fn(
         "checkpoint",
         |s: &mut ScriptSim, path: &str| -> ScriptResult<String> {

@@ -111,9 +111,8 @@ impl Checkpoint {
 
     /// Parses a checkpoint; `source` names the file in errors.
     pub fn from_json(text: &str, source: &str) -> Result<Self> {
-        let ck: Checkpoint = serde_json::from_str(text).map_err(|e| {
-            Error::Input(format!("{source} is not a tribo checkpoint: {e}"))
-        })?;
+        let ck: Checkpoint = serde_json::from_str(text)
+            .map_err(|e| Error::Input(format!("{source} is not a tribo checkpoint: {e}")))?;
         if ck.format != FORMAT || ck.version != VERSION {
             return Err(Error::Input(format!(
                 "{source}: checkpoint format '{}' version {} (this tribo reads '{FORMAT}' version {VERSION})",
@@ -128,14 +127,17 @@ impl Checkpoint {
     pub fn restore(self, sim: &mut Simulation) -> Result<()> {
         let here = Fingerprint::of(sim);
         if here != self.model {
-            let what = if here.nodes != self.model.nodes || here.elements != self.model.elements
-            {
+            let what = if here.nodes != self.model.nodes || here.elements != self.model.elements {
                 format!(
                     "mesh: {} nodes / {} elements in the checkpoint, {} / {} in the script",
                     self.model.nodes, self.model.elements, here.nodes, here.elements
                 )
             } else if here.tools.len() != self.model.tools.len()
-                || here.tools.iter().zip(&self.model.tools).any(|(a, b)| a.0 != b.0)
+                || here
+                    .tools
+                    .iter()
+                    .zip(&self.model.tools)
+                    .any(|(a, b)| a.0 != b.0)
             {
                 format!(
                     "tools: {:?} in the checkpoint, {:?} in the script",
@@ -153,7 +155,10 @@ impl Checkpoint {
         let shapes_ok = s.x.len() == here.unknowns
             && s.points.len() == sim.points().len()
             && s.contact.len() == here.tools.len()
-            && s.contact.iter().zip(&here.tools).all(|(c, t)| c.len() == t.1.len())
+            && s.contact
+                .iter()
+                .zip(&here.tools)
+                .all(|(c, t)| c.len() == t.1.len())
             && s.history_len == self.history.len();
         if !shapes_ok {
             return Err(Error::Input(

@@ -3,8 +3,8 @@
 pub mod assembly;
 pub mod augmentation;
 pub mod checkpoint;
-pub mod cycling;
 pub mod condense;
+pub mod cycling;
 pub mod linear;
 pub mod model;
 pub mod simulation;

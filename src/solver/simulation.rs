@@ -4,12 +4,12 @@
 //! leaves the last converged state untouched.
 
 use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use super::checkpoint::SavedState;
 use super::condense::Condenser;
+use super::cycling::{CyclingMonitor, CyclingNode};
 use super::linear::{FaerLu, LinearSolver};
 use super::model::Model;
-use super::cycling::{CyclingMonitor, CyclingNode};
 use super::sparse::SparsePattern;
-use super::checkpoint::SavedState;
 use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
 use crate::element::{Element, Hex8};
@@ -674,8 +674,8 @@ impl Simulation {
                     "non-finite residual at iteration {iterations}"
                 )));
             }
-            let force_ok =
-                rec.force <= settings.force_rel_tol * reference || rec.force <= settings.force_abs_tol;
+            let force_ok = rec.force <= settings.force_rel_tol * reference
+                || rec.force <= settings.force_abs_tol;
             if force_ok && rec.contact <= settings.contact_tol {
                 break;
             }
@@ -693,8 +693,7 @@ impl Simulation {
                     .windows(2)
                     .all(|w| w[1] > w[0])
                 && merit > merits[0];
-            if grew
-                || (iterations >= 4 && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30))
+            if grew || (iterations >= 4 && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30))
             {
                 return Err(Error::NoConvergence(format!(
                     "Newton diverges (force residual grew to {:.3e} relative); {}{}",
@@ -706,8 +705,15 @@ impl Simulation {
             let ts = Instant::now();
             let dx = self.newton_step(&eval, linear)?;
             times.factorization_and_solve += ts.elapsed().as_secs_f64();
-            let (x_new, eval_new, cuts) =
-                self.line_search(&ctx, &x, &dx, merit, monitor.damping(), &weights, &mut times)?;
+            let (x_new, eval_new, cuts) = self.line_search(
+                &ctx,
+                &x,
+                &dx,
+                merit,
+                monitor.damping(),
+                &weights,
+                &mut times,
+            )?;
             line_search_cuts += cuts;
             x = x_new;
             eval = eval_new;
@@ -749,9 +755,8 @@ impl Simulation {
         weights: &[f64],
         times: &mut PhaseTimes,
     ) -> Result<(Vec<f64>, Evaluation, usize)> {
-        let trial_x = |alpha: f64| -> Vec<f64> {
-            x.iter().zip(dx).map(|(xi, d)| xi + alpha * d).collect()
-        };
+        let trial_x =
+            |alpha: f64| -> Vec<f64> { x.iter().zip(dx).map(|(xi, d)| xi + alpha * d).collect() };
         if !self.model.settings.stepping.line_search {
             let xn = trial_x(alpha0);
             let e = ctx.evaluate(&xn, times)?;

@@ -123,7 +123,7 @@ impl StepSettings {
             ("target_iterations", self.target_iterations as f64),
         ];
         for (what, v) in positive {
-            if !(v > 0.0) {
+            if v.is_nan() || v <= 0.0 {
                 return Err(Error::input(what, v, "must be > 0"));
             }
         }
@@ -241,8 +241,12 @@ pub fn rotation_increment(f_old: &crate::geometry::Mat3, f_new: &crate::geometry
         incremental_rotation(f_old, f_new)
     } else {
         let d = f_new - f_old;
-        0.5 * crate::geometry::Vec3::new(d[(2, 1)] - d[(1, 2)], d[(0, 2)] - d[(2, 0)], d[(1, 0)] - d[(0, 1)])
-            .norm()
+        0.5 * crate::geometry::Vec3::new(
+            d[(2, 1)] - d[(1, 2)],
+            d[(0, 2)] - d[(2, 0)],
+            d[(1, 0)] - d[(0, 1)],
+        )
+        .norm()
     }
 }
 
