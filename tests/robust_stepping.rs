@@ -16,6 +16,15 @@ fn out_dir(name: &str) -> PathBuf {
     d
 }
 
+/// Output to `dir`, warnings not printed.
+fn quiet_host(dir: &Path) -> HostOptions {
+    HostOptions {
+        out_dir: dir.to_path_buf(),
+        warnings: false,
+        ..HostOptions::default()
+    }
+}
+
 fn robust_script(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/robust")
@@ -108,21 +117,15 @@ fn last_frame(dir: &Path) -> PathBuf {
 fn scripted_restart_continues_from_a_written_checkpoint() {
     let script = robust_script("restart_drag.rhai");
     let full_dir = out_dir("restart-full");
-    let host = HostOptions {
-        out_dir: full_dir.clone(),
-        warnings: false,
-        ..HostOptions::default()
-    };
+    let host = quiet_host(&full_dir);
     script::run_file(&script, &[], &host).unwrap();
     let checkpoint = full_dir.join("checkpoints/checkpoint_0002.json");
     assert!(checkpoint.is_file(), "checkpoint written");
 
     let rest_dir = out_dir("restart-rest");
     let host = HostOptions {
-        out_dir: rest_dir.clone(),
         restart: Some(checkpoint),
-        warnings: false,
-        ..HostOptions::default()
+        ..quiet_host(&rest_dir)
     };
     script::run_file(&script, &[], &host).unwrap();
     let u_full = read_vtu_point_field(&last_frame(&full_dir), "displacement").unwrap();
@@ -251,11 +254,7 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
         v
     };
     let fixed_dir = out_dir("fast-fixed");
-    let host = HostOptions {
-        out_dir: fixed_dir.clone(),
-        warnings: false,
-        ..HostOptions::default()
-    };
+    let host = quiet_host(&fixed_dir);
     let err = script::run_file(&script, &sets("fixed"), &host)
         .unwrap_err()
         .to_string();
@@ -275,11 +274,7 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
     assert!(summary.contains("\"stopped\""), "{summary}");
 
     let adaptive_dir = out_dir("fast-adaptive");
-    let host = HostOptions {
-        out_dir: adaptive_dir.clone(),
-        warnings: false,
-        ..HostOptions::default()
-    };
+    let host = quiet_host(&adaptive_dir);
     script::run_file(&script, &sets("adaptive"), &host).unwrap();
     let time = history_column(&adaptive_dir, "time");
     let cutbacks = history_column(&adaptive_dir, "cutbacks");
