@@ -421,3 +421,24 @@ fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
     assert!(err.contains("is not a tribo checkpoint"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// When the increment cannot be completed at the minimum step the run stops with the
+/// reason and the nodes where the residual is largest; the committed state is untouched.
+#[test]
+fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
+    let mut model = adaptive_drag();
+    // One Newton iteration cannot converge a contact increment; dt cannot be cut below 0.4.
+    model.settings.max_iterations = 1;
+    model.settings.stepping.dt_min = Some(0.4);
+    let mut sim = Simulation::new(model).unwrap();
+    let err = sim.step().unwrap_err().to_string();
+    println!("{err}");
+    assert!(
+        err.contains("cannot be completed at the minimum step") && err.contains("dt_min = 4"),
+        "{err}"
+    );
+    assert!(err.contains("largest force residual at node(s)"), "{err}");
+    assert_eq!(sim.time(), 0.0);
+    assert!(sim.displacements().iter().all(|&u| u == 0.0));
+    assert!(sim.history.is_empty());
+}
