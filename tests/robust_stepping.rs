@@ -305,15 +305,19 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
 #[test]
 fn anti_cycling_makes_a_high_friction_drag_converge() {
     let script = robust_script("high_friction_drag.rhai");
-    let run = |mode: &str| {
-        let dir = out_dir(&format!("cycling-{mode}"));
+    let run_with = |mode: &str, line_search: bool| {
+        let dir = out_dir(&format!("cycling-{mode}-{line_search}"));
         let host = HostOptions {
             out_dir: dir.clone(),
             ..HostOptions::default()
         };
-        let sets = [script::parse_override(&format!("anti_cycling={mode}")).unwrap()];
+        let sets = [
+            script::parse_override(&format!("anti_cycling={mode}")).unwrap(),
+            script::parse_override(&format!("line_search={line_search}")).unwrap(),
+        ];
         (script::run_file(&script, &sets, &host), dir)
     };
+    let run = |mode: &str| run_with(mode, false);
     let (off, off_dir) = run("off");
     let err = off.unwrap_err().to_string();
     println!("without anti-cycling: {err}");
@@ -330,8 +334,17 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
         iterations.iter().all(|&i| i <= 12.0),
         "converges in a few iterations: {iterations:?}"
     );
+    // The line search alone also gets through: it backtracks the cycling full steps.
+    let (searched, searched_dir) = run_with("off", true);
+    searched.unwrap();
+    println!(
+        "line search, no anti-cycling: iterations {:?}, backtracks {:?}",
+        history_column(&searched_dir, "newton_iterations"),
+        history_column(&searched_dir, "line_search_cuts")
+    );
     let _ = std::fs::remove_dir_all(&off_dir);
     let _ = std::fs::remove_dir_all(&on_dir);
+    let _ = std::fs::remove_dir_all(&searched_dir);
 }
 
 /// The REPL steps, rolls back to the previous converged increment, switches to adaptive
