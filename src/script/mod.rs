@@ -6,6 +6,7 @@
 
 mod api_scene;
 mod api_sim;
+mod api_tools;
 mod convert;
 pub mod repl;
 mod stdlib;
@@ -67,6 +68,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.set_module_resolver(stdlib::resolver(script_dir));
     let host = Rc::new(host.clone());
     api_scene::register(&mut engine, host.clone());
+    api_tools::register(&mut engine, script_dir);
     api_sim::register(&mut engine, host);
     register_checks(&mut engine);
     engine
