@@ -96,6 +96,20 @@ fn restart_from_a_checkpoint_reproduces_the_uninterrupted_run() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("does not belong to this model"), "{err}");
+    // Same mesh, another tool path: the tool is elsewhere at the checkpoint's time.
+    let mut moved = adaptive_drag();
+    moved.contacts[0].tool.schedule = tribo::tool::schedule::Schedule::new(vec![
+        (0.0, tribo::geometry::Vec3::zeros()),
+        (3.0, tribo::geometry::Vec3::new(0.0, 0.0, -0.12)),
+    ])
+    .unwrap();
+    let mut moved = Simulation::new(moved).unwrap();
+    let err = Checkpoint::from_json(&json, "memory")
+        .unwrap()
+        .restore(&mut moved)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("the schedules changed"), "{err}");
     let err = Checkpoint::from_json("{\"x\": 1}", "bad.json")
         .unwrap_err()
         .to_string();

@@ -373,6 +373,9 @@ pub fn schedule_stops(model: &Model) -> Vec<f64> {
     let mut stops: Vec<f64> = Vec::new();
     for c in &model.contacts {
         stops.extend(c.tool.schedule.points().iter().map(|p| p.0));
+        if let Some(r) = c.tool.schedule.rotation() {
+            stops.extend(r.angle.points().iter().map(|p| p.0));
+        }
     }
     for d in &model.dirichlet {
         stops.extend(d.value.points().iter().map(|p| p.0));
