@@ -89,12 +89,12 @@ fn restart_from_a_checkpoint_reproduces_the_uninterrupted_run() {
     assert!((e_full - e_rest).abs() <= 1e-12 * e_full.abs().max(1.0));
 
     // A checkpoint of another model is refused with a message naming the difference.
-    let mut other = Simulation::new(common::cylinder_drag_model(8.0, 2.0, 8, 3.0)).unwrap();
-    let err = Checkpoint::from_json(&json, "memory")
-        .unwrap()
-        .restore(&mut other)
-        .unwrap_err()
-        .to_string();
+    let refused = |model| {
+        let mut sim = Simulation::new(model).unwrap();
+        let ck = Checkpoint::from_json(&json, "memory").unwrap();
+        ck.restore(&mut sim).unwrap_err().to_string()
+    };
+    let err = refused(common::cylinder_drag_model(8.0, 2.0, 8, 3.0));
     assert!(err.contains("does not belong to this model"), "{err}");
     // Same mesh, another tool path: the tool is elsewhere at the checkpoint's time.
     let mut moved = adaptive_drag();
@@ -103,12 +103,7 @@ fn restart_from_a_checkpoint_reproduces_the_uninterrupted_run() {
         (3.0, tribo::geometry::Vec3::new(0.0, 0.0, -0.12)),
     ])
     .unwrap();
-    let mut moved = Simulation::new(moved).unwrap();
-    let err = Checkpoint::from_json(&json, "memory")
-        .unwrap()
-        .restore(&mut moved)
-        .unwrap_err()
-        .to_string();
+    let err = refused(moved);
     assert!(err.contains("the schedules changed"), "{err}");
     let err = Checkpoint::from_json("{\"x\": 1}", "bad.json")
         .unwrap_err()

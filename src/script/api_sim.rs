@@ -394,7 +394,7 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
         ("force_tolerance", s.force_rel_tol),
         ("contact_tolerance", s.contact_tol),
     ] {
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return fail(Error::input(what, v, "must be > 0"));
         }
     }
