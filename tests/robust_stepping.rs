@@ -16,6 +16,15 @@ fn out_dir(name: &str) -> PathBuf {
     d
 }
 
+/// Output to `dir`, warnings not printed.
+fn quiet_host(dir: &Path) -> HostOptions {
+    HostOptions {
+        out_dir: dir.to_path_buf(),
+        warnings: false,
+        ..HostOptions::default()
+    }
+}
+
 fn robust_script(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/robust")
@@ -80,13 +89,22 @@ fn restart_from_a_checkpoint_reproduces_the_uninterrupted_run() {
     assert!((e_full - e_rest).abs() <= 1e-12 * e_full.abs().max(1.0));
 
     // A checkpoint of another model is refused with a message naming the difference.
-    let mut other = Simulation::new(common::cylinder_drag_model(8.0, 2.0, 8, 3.0)).unwrap();
-    let err = Checkpoint::from_json(&json, "memory")
-        .unwrap()
-        .restore(&mut other)
-        .unwrap_err()
-        .to_string();
+    let refused = |model| {
+        let mut sim = Simulation::new(model).unwrap();
+        let ck = Checkpoint::from_json(&json, "memory").unwrap();
+        ck.restore(&mut sim).unwrap_err().to_string()
+    };
+    let err = refused(common::cylinder_drag_model(8.0, 2.0, 8, 3.0));
     assert!(err.contains("does not belong to this model"), "{err}");
+    // Same mesh, another tool path: the tool is elsewhere at the checkpoint's time.
+    let mut moved = adaptive_drag();
+    moved.contacts[0].tool.schedule = tribo::tool::schedule::Schedule::new(vec![
+        (0.0, tribo::geometry::Vec3::zeros()),
+        (3.0, tribo::geometry::Vec3::new(0.0, 0.0, -0.12)),
+    ])
+    .unwrap();
+    let err = refused(moved);
+    assert!(err.contains("the schedules changed"), "{err}");
     let err = Checkpoint::from_json("{\"x\": 1}", "bad.json")
         .unwrap_err()
         .to_string();
@@ -108,21 +126,15 @@ fn last_frame(dir: &Path) -> PathBuf {
 fn scripted_restart_continues_from_a_written_checkpoint() {
     let script = robust_script("restart_drag.rhai");
     let full_dir = out_dir("restart-full");
-    let host = HostOptions {
-        out_dir: full_dir.clone(),
-        warnings: false,
-        ..HostOptions::default()
-    };
+    let host = quiet_host(&full_dir);
     script::run_file(&script, &[], &host).unwrap();
     let checkpoint = full_dir.join("checkpoints/checkpoint_0002.json");
     assert!(checkpoint.is_file(), "checkpoint written");
 
     let rest_dir = out_dir("restart-rest");
     let host = HostOptions {
-        out_dir: rest_dir.clone(),
         restart: Some(checkpoint),
-        warnings: false,
-        ..HostOptions::default()
+        ..quiet_host(&rest_dir)
     };
     script::run_file(&script, &[], &host).unwrap();
     let u_full = read_vtu_point_field(&last_frame(&full_dir), "displacement").unwrap();
@@ -251,11 +263,7 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
         v
     };
     let fixed_dir = out_dir("fast-fixed");
-    let host = HostOptions {
-        out_dir: fixed_dir.clone(),
-        warnings: false,
-        ..HostOptions::default()
-    };
+    let host = quiet_host(&fixed_dir);
     let err = script::run_file(&script, &sets("fixed"), &host)
         .unwrap_err()
         .to_string();
@@ -275,11 +283,7 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
     assert!(summary.contains("\"stopped\""), "{summary}");
 
     let adaptive_dir = out_dir("fast-adaptive");
-    let host = HostOptions {
-        out_dir: adaptive_dir.clone(),
-        warnings: false,
-        ..HostOptions::default()
-    };
+    let host = quiet_host(&adaptive_dir);
     script::run_file(&script, &sets("adaptive"), &host).unwrap();
     let time = history_column(&adaptive_dir, "time");
     let cutbacks = history_column(&adaptive_dir, "cutbacks");
@@ -300,4 +304,163 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
     assert!(total >= 1.0, "cutbacks recorded in history.csv");
     let _ = std::fs::remove_dir_all(&fixed_dir);
     let _ = std::fs::remove_dir_all(&adaptive_dir);
+}
+
+/// High friction (mu = 0.5), oblique drag of a small ball, full Newton steps: a node at the
+/// edge of the contact cycles between stick and slip. Without the treatment Newton
+/// diverges; freezing the node's status converges in a few iterations, the node is named in
+/// the report and history.csv, and the state reached also satisfies the free law to the
+/// Newton tolerances (the residual of the unfrozen operator there is printed).
+#[test]
+fn anti_cycling_makes_a_high_friction_drag_converge() {
+    let script = robust_script("high_friction_drag.rhai");
+    let run_with = |mode: &str, line_search: bool| {
+        let dir = out_dir(&format!("cycling-{mode}-{line_search}"));
+        let host = HostOptions {
+            out_dir: dir.clone(),
+            ..HostOptions::default()
+        };
+        let sets = [
+            script::parse_override(&format!("anti_cycling={mode}")).unwrap(),
+            script::parse_override(&format!("line_search={line_search}")).unwrap(),
+        ];
+        (script::run_file(&script, &sets, &host), dir)
+    };
+    let run = |mode: &str| run_with(mode, false);
+    let (off, off_dir) = run("off");
+    let err = off.unwrap_err().to_string();
+    println!("without anti-cycling: {err}");
+    assert!(err.contains("status cycling at node(s)"), "{err}");
+    let (on, on_dir) = run("freeze");
+    on.unwrap();
+    let iterations = history_column(&on_dir, "newton_iterations");
+    let cycling = history_column(&on_dir, "cycling_nodes");
+    let frozen = history_column(&on_dir, "frozen_nodes");
+    println!("with anti-cycling: Newton iterations per increment {iterations:?}, cycling nodes {cycling:?}, frozen {frozen:?}");
+    assert_eq!(iterations.len(), 4);
+    assert!(frozen.iter().sum::<f64>() >= 1.0, "a node was frozen");
+    assert!(
+        iterations.iter().all(|&i| i <= 12.0),
+        "converges in a few iterations: {iterations:?}"
+    );
+    // The line search alone also gets through: it backtracks the cycling full steps.
+    let (searched, searched_dir) = run_with("off", true);
+    searched.unwrap();
+    println!(
+        "line search, no anti-cycling: iterations {:?}, backtracks {:?}",
+        history_column(&searched_dir, "newton_iterations"),
+        history_column(&searched_dir, "line_search_cuts")
+    );
+    let _ = std::fs::remove_dir_all(&off_dir);
+    let _ = std::fs::remove_dir_all(&on_dir);
+    let _ = std::fs::remove_dir_all(&searched_dir);
+}
+
+/// The REPL steps, rolls back to the previous converged increment, switches to adaptive
+/// steps and steps on; history.csv follows the rollback.
+#[test]
+fn repl_rolls_back_and_changes_a_setting_before_stepping_on() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scripts/cylinder_drag.rhai");
+    let out = out_dir("repl-rollback");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .arg("repl")
+        .arg(&script)
+        .arg("--out")
+        .arg(&out)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(
+            b"sim.step(); sim.step(); sim.step();\n\
+              sim.rollback()\n\
+              sim.history().len()\n\
+              sim.settings(#{ step_control: \"adaptive\", dt_max: 0.05 });\n\
+              sim.step(); sim.time\n\
+              sim.rollback(9)\n\
+              :quit\n",
+        )
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    println!("{stdout}");
+    // Three nominal increments of 0.1, back to 0.2, then one adaptive step of 0.05.
+    assert!(lines.iter().any(|l| l.trim() == "0.2"), "{stdout}");
+    assert!(lines.iter().any(|l| l.trim() == "2"), "{stdout}");
+    assert!(
+        lines.iter().any(|l| l.trim().starts_with("0.25")),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("cannot roll back 9 increment(s)"),
+        "{stdout}"
+    );
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert_eq!(
+        history.lines().count(),
+        1 + 3,
+        "header + 2 kept + 1 new row"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
+    use std::process::Command;
+    let script = robust_script("restart_drag.rhai");
+    let dir = out_dir("bad-restart");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |ck: &Path| {
+        let out = Command::new(env!("CARGO_BIN_EXE_tribo"))
+            .args(["run", "--quiet", "--restart"])
+            .arg(ck)
+            .arg("--out")
+            .arg(dir.join("out"))
+            .arg(&script)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(
+            !out.status.success() && !stderr.contains("panicked"),
+            "{stderr}"
+        );
+        stderr
+    };
+    let err = run(&dir.join("missing.json"));
+    assert!(err.contains("missing.json"), "{err}");
+    let foreign = dir.join("foreign.json");
+    std::fs::write(&foreign, "{\"format\": \"something else\"}").unwrap();
+    let err = run(&foreign);
+    assert!(err.contains("is not a tribo checkpoint"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// When the increment cannot be completed at the minimum step the run stops with the
+/// reason and the nodes where the residual is largest; the committed state is untouched.
+#[test]
+fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
+    let mut model = adaptive_drag();
+    // One Newton iteration cannot converge a contact increment; dt cannot be cut below 0.4.
+    model.settings.max_iterations = 1;
+    model.settings.stepping.dt_min = Some(0.4);
+    let mut sim = Simulation::new(model).unwrap();
+    let err = sim.step().unwrap_err().to_string();
+    println!("{err}");
+    assert!(
+        err.contains("cannot be completed at the minimum step") && err.contains("dt_min = 4"),
+        "{err}"
+    );
+    assert!(err.contains("largest force residual at node(s)"), "{err}");
+    assert_eq!(sim.time(), 0.0);
+    assert!(sim.displacements().iter().all(|&u| u == 0.0));
+    assert!(sim.history.is_empty());
 }

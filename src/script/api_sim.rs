@@ -230,6 +230,30 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     m.insert("time".into(), Dynamic::from(r.time));
     m.insert("iterations".into(), Dynamic::from(r.iterations as i64));
     m.insert("cutbacks".into(), Dynamic::from(r.cutbacks as i64));
+    m.insert("dt".into(), Dynamic::from(r.dt));
+    m.insert("rejected_steps".into(), Dynamic::from(r.rejected as i64));
+    m.insert(
+        "line_search_cuts".into(),
+        Dynamic::from(r.line_search_cuts as i64),
+    );
+    m.insert(
+        "cycling_nodes".into(),
+        Dynamic::from(
+            r.cycling
+                .iter()
+                .map(|c| Dynamic::from(c.node as i64))
+                .collect::<Array>(),
+        ),
+    );
+    m.insert(
+        "warnings".into(),
+        Dynamic::from(
+            r.warnings
+                .iter()
+                .map(|w| Dynamic::from(w.clone()))
+                .collect::<Array>(),
+        ),
+    );
     m.insert("active_nodes".into(), Dynamic::from(r.active_nodes as i64));
     m.insert(
         "slipping_nodes".into(),
@@ -420,7 +444,7 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
         ("force_tolerance", s.force_rel_tol),
         ("contact_tolerance", s.contact_tol),
     ] {
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return fail(Error::input(what, v, "must be > 0"));
         }
     }
@@ -542,15 +566,14 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             }
             let mut st = s.borrow_mut();
             st.simulation()?;
-            let total = {
-                let sim = st.sim.as_ref().expect("started");
-                sim.model.settings.increments as u64
-            };
+            // Progress in pseudo-time (per mille): the number of adaptive increments is not
+            // known beforehand.
+            let end_time = st.sim.as_ref().expect("started").model.settings.end_time;
             let bar = h.progress.then(|| {
-                let b = indicatif::ProgressBar::new(total);
+                let b = indicatif::ProgressBar::new(1000);
                 b.set_style(
                     indicatif::ProgressStyle::with_template(
-                        "{bar:40} {pos}/{len} increments  {msg}  [{elapsed_precise}]",
+                        "{bar:40} {percent:>3}% of the time  {msg}  [{elapsed_precise}]",
                     )
                     .expect("valid template"),
                 );
@@ -569,10 +592,10 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                     }
                 };
                 if let Some(b) = &bar {
-                    b.inc(1);
+                    b.set_position((1000.0 * r.time / end_time).round() as u64);
                     b.set_message(format!(
-                        "t = {:.4}, {} Newton iterations",
-                        r.time, r.iterations
+                        "increment {}, t = {:.4}, dt = {:.3e}, {} Newton iterations",
+                        r.index, r.time, r.dt, r.iterations
                     ));
                 }
                 last = Some(r);

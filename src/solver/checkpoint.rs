@@ -39,6 +39,9 @@ pub struct SavedState {
     pub energy: EnergyBalance,
     pub energy_memory: EnergyMemory,
     pub controller: StepController,
+    /// The last increment's (dt, change of the unknowns), for the extrapolating predictor.
+    #[serde(default)]
+    pub last_step: Option<(f64, Vec<f64>)>,
 }
 
 /// Sizes and names that must agree between the checkpoint and the rebuilt model.
@@ -73,8 +76,9 @@ pub struct Checkpoint {
     pub format: String,
     pub version: u32,
     pub model: Fingerprint,
-    /// Each tool's translation at the checkpoint's time (a check on the schedules).
-    pub tool_translations: Vec<[f64; 3]>,
+    /// Each tool's pose at the checkpoint's time, as the images of the origin and of the
+    /// three unit points of the tool's frame (a check on the schedules).
+    pub tool_poses: Vec<[[f64; 3]; 4]>,
     pub state: SavedState,
     pub history: Vec<IncrementReport>,
     /// Times of the VTK frames the run had written when the checkpoint was taken.
@@ -89,14 +93,11 @@ impl Checkpoint {
             format: FORMAT.into(),
             version: VERSION,
             model: Fingerprint::of(sim),
-            tool_translations: sim
+            tool_poses: sim
                 .model
                 .contacts
                 .iter()
-                .map(|c| {
-                    let u = c.tool.schedule.translation(state.time);
-                    [u.x, u.y, u.z]
-                })
+                .map(|c| pose_points(&c.tool.pose(state.time)))
                 .collect(),
             history: sim.history.clone(),
             state,
@@ -165,22 +166,18 @@ impl Checkpoint {
                 "the checkpoint is inconsistent (array sizes do not match its model)".into(),
             ));
         }
-        for (c, (contact, stored)) in sim
-            .model
-            .contacts
-            .iter()
-            .zip(&self.tool_translations)
-            .enumerate()
-        {
-            let u = contact.tool.schedule.translation(s.time);
-            let d = (u - crate::geometry::Vec3::from(*stored)).norm();
-            if d > 1e-12 * (1.0 + u.norm()) {
+        for (c, (contact, stored)) in sim.model.contacts.iter().zip(&self.tool_poses).enumerate() {
+            let here = pose_points(&contact.tool.pose(s.time));
+            let d = here
+                .iter()
+                .zip(stored)
+                .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+                .fold(0.0, f64::max);
+            let scale = 1.0 + here.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            if d > 1e-12 * scale {
                 return Err(Error::Input(format!(
-                    "tool {c} '{}' is at {:?} at t = {} in the script but at {:?} in the checkpoint: the schedules changed",
-                    contact.tool.name,
-                    [u.x, u.y, u.z],
-                    s.time,
-                    stored
+                    "tool {c} '{}' is placed differently at t = {} in the script than in the checkpoint (origin at {:?}, was {:?}): the schedules changed",
+                    contact.tool.name, s.time, here[0], stored[0]
                 )));
             }
         }
@@ -195,4 +192,13 @@ impl Checkpoint {
         sim.clear_rollback();
         Ok(())
     }
+}
+
+/// The images of the origin and of the unit points of a tool's frame.
+fn pose_points(pose: &crate::tool::pose::Pose) -> [[f64; 3]; 4] {
+    use crate::geometry::Vec3;
+    [Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::z()].map(|p| {
+        let g = pose.to_global_point(&p);
+        [g.x, g.y, g.z]
+    })
 }

@@ -1,6 +1,7 @@
 //! Sparse assembly, linear solves, Newton iteration and incremental stepping.
 
 pub mod assembly;
+pub mod augmentation;
 pub mod checkpoint;
 pub mod condense;
 pub mod cycling;

@@ -190,12 +190,15 @@ impl Model {
         }
         let candidates = self.nodes(set)?;
         let areas = self.mesh.tributary_areas(&candidates)?;
-        // P-wave modulus times a length: the stiffness of a column of material under the node.
-        let stiffness = self.material.elastic_tangent()[(0, 0)];
-        let r = areas
-            .iter()
-            .map(|a| r.unwrap_or_else(|| stiffness * a.max(f64::MIN_POSITIVE).sqrt()))
-            .collect();
+        let r = match r {
+            Some(r) => vec![r; candidates.len()],
+            // The stiffness of the column of material under each node (see `augmentation`).
+            None => super::augmentation::default_r(
+                &self.mesh,
+                self.material.elastic_tangent()[(0, 0)],
+                &candidates,
+            )?,
+        };
         self.contacts.push(ToolContact {
             tool,
             candidates,

@@ -676,10 +676,13 @@ impl Simulation {
         let mut iterations = 0;
         let mut line_search_cuts = 0;
         let mut eval = ctx.evaluate(&x, &mut times)?;
+        // Merits before a freeze belong to another problem: divergence is judged after it.
+        let mut window_start = 0;
         loop {
             if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
                 ctx.forced = monitor.forced();
                 eval = ctx.evaluate(&x, &mut times)?;
+                window_start = merits.len();
             }
             let (rec, merit, reference) = self.residual_record(&eval, &weights);
             residuals.push(rec);
@@ -722,7 +725,7 @@ impl Simulation {
                 .find(|&v| v > 0.0)
                 .unwrap_or(1e-30);
             let first_merit = merits.iter().copied().find(|&v| v > 0.0).unwrap_or(0.0);
-            let grew = merits.len() > DIVERGENCE_ITERATIONS
+            let grew = merits.len() > window_start + DIVERGENCE_ITERATIONS
                 && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
                     .windows(2)
                     .all(|w| w[1] > w[0])
@@ -1059,6 +1062,7 @@ impl Simulation {
             energy: self.energy.clone(),
             energy_memory: self.energy_memory.clone(),
             controller: self.controller,
+            last_step: self.last_step.clone(),
         }
     }
 
@@ -1074,6 +1078,7 @@ impl Simulation {
         self.energy = state.energy;
         self.energy_memory = state.energy_memory;
         self.controller = state.controller;
+        self.last_step = state.last_step;
     }
 
     /// Replaces the settings of a running simulation (after a rollback in the REPL, say).

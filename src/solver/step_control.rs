@@ -93,7 +93,7 @@ impl Default for StepSettings {
             growth: 2.0,
             line_search: true,
             anti_cycling: AntiCycling::Freeze,
-            cycle_flips: 4,
+            cycle_flips: 3,
             rollback_depth: 3,
         }
     }
@@ -123,7 +123,7 @@ impl StepSettings {
             ("target_iterations", self.target_iterations as f64),
         ];
         for (what, v) in positive {
-            if !(v > 0.0) {
+            if v.is_nan() || v <= 0.0 {
                 return Err(Error::input(what, v, "must be > 0"));
             }
         }
@@ -373,6 +373,9 @@ pub fn schedule_stops(model: &Model) -> Vec<f64> {
     let mut stops: Vec<f64> = Vec::new();
     for c in &model.contacts {
         stops.extend(c.tool.schedule.points().iter().map(|p| p.0));
+        if let Some(r) = c.tool.schedule.rotation() {
+            stops.extend(r.angle.points().iter().map(|p| p.0));
+        }
     }
     for d in &model.dirichlet {
         stops.extend(d.value.points().iter().map(|p| p.0));
