@@ -1,0 +1,88 @@
+//! The NUMISHEET'93 square cup script (`scripts/square_cup.rhai`), run on a coarse mesh for
+//! the first millimetres of punch travel in both process variants, through the real command
+//! line. The script writes its own checks into summary.json; this test holds them to
+//! bounds that follow from the discrete problem:
+//!
+//! - vertical force balance: the symmetry planes hold only x and y, so punch, blankholder and
+//!   die forces cancel along z up to Newton's force tolerance (1e-9 relative): < 1e-6;
+//! - quarter symmetry about the diagonal x = y: the mesh, the tools and the isotropic
+//!   material are symmetric, so the converged displacements are, up to the same tolerance
+//!   times the compliance: < 1e-6 of the largest displacement;
+//! - frictional work >= 0 at every node (it only grows by lambda_t . delta_t >= 0), and mu
+//!   within the law's control points: [0.01, 0.16] for the paper's Bernstein curve, 0.162 for
+//!   the benchmark's Coulomb friction;
+//! - the benchmark's blankholder, under force control, carries 4 x 4.9 kN on the full cup.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn run_cup(variant: &str, out: &Path) -> Value {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let status = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .current_dir(root)
+        .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
+        .arg(out)
+        .args(["--set", "cells=8", "--set", "travel=3.0", "--set"])
+        .arg(format!("variant=\"{variant}\""))
+        .status()
+        .expect("tribo runs");
+    assert!(status.success(), "square cup ({variant}) failed");
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tribo_square_cup_{name}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn number(v: &Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("summary has no number '{key}': {v}"))
+}
+
+fn common_checks(summary: &Value, mu_range: (f64, f64)) {
+    assert_eq!(summary["status"], "finished", "{summary}");
+    let checks = &summary["checks"];
+    assert!(number(checks, "vertical_force_balance") < 1e-6, "{checks}");
+    assert!(number(checks, "diagonal_asymmetry") < 1e-6, "{checks}");
+    assert!(number(checks, "frictional_work_min") >= 0.0, "{checks}");
+    assert!(
+        number(checks, "frictional_work_max") > 0.0,
+        "no sliding at all: {checks}"
+    );
+    assert!(number(checks, "mu_min") >= mu_range.0 - 1e-12, "{checks}");
+    assert!(number(checks, "mu_max") <= mu_range.1 + 1e-12, "{checks}");
+    assert!(number(summary, "punch_force_peak_n") > 0.0);
+    assert!(summary["draw_in"].as_array().is_some());
+}
+
+#[test]
+fn paper_variant_first_millimetres() {
+    let out = out_dir("paper");
+    let summary = run_cup("paper", &out);
+    common_checks(&summary, (0.01, 0.16));
+    // The Bernstein curve has started to soften where the sheet slides hardest.
+    assert!(number(&summary["checks"], "mu_min") < 0.16);
+    for chart in ["punch_force.svg", "punch_force.csv"] {
+        assert!(out.join(chart).is_file(), "{chart} missing");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn benchmark_variant_holds_the_blankholder_force() {
+    let out = out_dir("benchmark");
+    let summary = run_cup("benchmark", &out);
+    common_checks(&summary, (0.162, 0.162));
+    let holder = &summary["tools"]["blankholder"]["final_force"][2];
+    let f = holder.as_f64().expect("blankholder force");
+    assert!(
+        (f - 4900.0).abs() < 1e-6 * 4900.0,
+        "quarter holder force {f}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
