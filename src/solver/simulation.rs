@@ -510,12 +510,25 @@ impl Simulation {
                     )
                 })
                 .collect();
+            // A long run prints this every increment: name the first few nodes only (the
+            // full list is in the report), and the free-law residual only when statuses
+            // were frozen (otherwise it is the converged residual).
+            const SHOWN: usize = 8;
+            let more = nodes.len().saturating_sub(SHOWN);
+            let frozen = trial.cycling.iter().any(|n| n.frozen.is_some());
             report.warnings.push(format!(
-                "contact status cycled at {} node(s): {}; free-law residual at the converged state: force {:.3e} relative, contact {:.3e}",
+                "contact status cycled at {} node(s): {}{}{}",
                 nodes.len(),
-                nodes.join(", "),
-                trial.unfrozen.force_rel,
-                trial.unfrozen.contact
+                nodes[..nodes.len().min(SHOWN)].join(", "),
+                if more > 0 { format!(" and {more} more") } else { String::new() },
+                if frozen {
+                    format!(
+                        "; free-law residual at the converged state: force {:.3e} relative, contact {:.3e}",
+                        trial.unfrozen.force_rel, trial.unfrozen.contact
+                    )
+                } else {
+                    String::new()
+                }
             ));
         }
         report.cycling = trial.cycling;
