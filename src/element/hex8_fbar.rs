@@ -55,9 +55,9 @@ use nalgebra::{SMatrix, SVector};
 use super::hex8::{
     check_len, jacobian, nodes_array, shape_derivatives, Geometry, DOFS, NODES, POINTS,
 };
-use super::{prefix, Element, ElementResponse};
+use super::{prefix, Element, ElementResponse, Hex8};
 use crate::geometry::{Mat3, Vec3};
-use crate::material::{stress_to_tensor, Material, PointState, Voigt};
+use crate::material::{stress_to_tensor, Material, PointState};
 use crate::{Error, Result};
 
 /// Voigt index pairs `[xx, yy, zz, xy, yz, zx]`.
@@ -142,11 +142,12 @@ impl Element<DOFS> for Hex8FBar {
         for gp in 0..POINTS {
             let b = &geo.grad[gp];
             let f = gradient(&u, b);
-            let (f_inv_t, j) =
-                inverse_transpose(&f, &format!("integration point {gp}"))?;
+            let (f_inv_t, j) = inverse_transpose(&f, &format!("integration point {gp}"))?;
             let g: [Vec3; NODES] = std::array::from_fn(|a| f_inv_t * b[a]);
             let (r, q) = if self.fbar {
-                let q = SVector::<f64, DOFS>::from_fn(|i, _| (g0[i / 3][i % 3] - g[i / 3][i % 3]) / 3.0);
+                let q = SVector::<f64, DOFS>::from_fn(|i, _| {
+                    (g0[i / 3][i % 3] - g[i / 3][i % 3]) / 3.0
+                });
                 ((j0 / j).cbrt(), q)
             } else {
                 (1.0, SVector::<f64, DOFS>::zeros())
@@ -161,11 +162,11 @@ impl Element<DOFS> for Hex8FBar {
 
             // G = ∂F̄/∂u (9 x 24).
             let mut gm = SMatrix::<f64, 9, DOFS>::zeros();
-            for a in 0..NODES {
+            for (a, ba) in b.iter().enumerate() {
                 for k in 0..3 {
                     let col = 3 * a + k;
                     for jj in 0..3 {
-                        gm[(3 * k + jj, col)] += r * b[a][jj];
+                        gm[(3 * k + jj, col)] += r * ba[jj];
                     }
                     if self.fbar {
                         for i in 0..9 {
@@ -206,9 +207,8 @@ impl Element<DOFS> for Hex8FBar {
                     for k in 0..3 {
                         for c in 0..NODES {
                             for l in 0..3 {
-                                extra[(3 * a + k, 3 * c + l)] += pf
-                                    * (g[a][l] * g[c][k] - g0[a][l] * g0[c][k])
-                                    / 3.0;
+                                extra[(3 * a + k, 3 * c + l)] +=
+                                    pf * (g[a][l] * g[c][k] - g0[a][l] * g0[c][k]) / 3.0;
                             }
                         }
                     }
@@ -219,26 +219,8 @@ impl Element<DOFS> for Hex8FBar {
         Ok(ElementResponse { force, stiffness })
     }
 
-    fn volume(&self, ref_coords: &[Vec3]) -> Result<f64> {
-        Ok(Geometry::new(&nodes_array("ref_coords", ref_coords)?)?.volume)
-    }
-
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>> {
-        Ok(Geometry::new(&nodes_array("ref_coords", ref_coords)?)?
-            .dvol
-            .to_vec())
-    }
-
-    /// Reference-volume average of the Cauchy stresses.
-    fn average_stress(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<Voigt> {
-        check_len("states", states.len(), POINTS)?;
-        let geo = Geometry::new(&nodes_array("ref_coords", ref_coords)?)?;
-        let sum: Voigt = states
-            .iter()
-            .zip(&geo.dvol)
-            .map(|(s, dv)| s.stress * *dv)
-            .sum();
-        Ok(sum / geo.volume)
+        Hex8.point_volumes(ref_coords)
     }
 
     /// `∫ ψ(T) dV₀` with the log-space stress (Hencky energy of the elastic log strain).
@@ -248,19 +230,12 @@ impl Element<DOFS> for Hex8FBar {
         states: &[PointState],
         material: &dyn Material,
     ) -> Result<f64> {
-        check_len("states", states.len(), POINTS)?;
-        let geo = Geometry::new(&nodes_array("ref_coords", ref_coords)?)?;
-        Ok(states
-            .iter()
-            .zip(&geo.dvol)
-            .map(|(s, dv)| {
-                let log_state = PointState {
-                    stress: s.log_stress,
-                    ..*s
-                };
-                material.elastic_energy_density(&log_state) * dv
+        self.integrate(ref_coords, states, &|s| {
+            material.elastic_energy_density(&PointState {
+                stress: s.log_stress,
+                ..*s
             })
-            .sum())
+        })
     }
 }
 
@@ -285,7 +260,11 @@ mod tests {
         x: &[Vec3; 8],
         u: &[Vec3; 8],
         m: &dyn Material,
-    ) -> ([PointState; POINTS], ElementResponse<DOFS>, [PointState; POINTS]) {
+    ) -> (
+        [PointState; POINTS],
+        ElementResponse<DOFS>,
+        [PointState; POINTS],
+    ) {
         let half = u.map(|v| v * 0.5);
         let mut committed = [PointState::default(); POINTS];
         let mut trial = committed;

@@ -103,7 +103,11 @@ impl Hill48 {
     /// turned about z (the sheet normal); see the module docs.
     pub fn with_rolling_angle(self, angle: f64) -> Result<Self> {
         if !angle.is_finite() {
-            return Err(Error::input("rolling-direction angle", angle, "must be finite"));
+            return Err(Error::input(
+                "rolling-direction angle",
+                angle,
+                "must be finite",
+            ));
         }
         let (s, c) = angle.sin_cos();
         let q = crate::geometry::Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);

@@ -282,7 +282,13 @@ fn register_material(engine: &mut Engine) {
     );
     engine.register_fn(
         "hill48_coefficients",
-        |f: Dynamic, g: Dynamic, h: Dynamic, l: Dynamic, m: Dynamic, n: Dynamic| -> ScriptResult<Hill48> {
+        |f: Dynamic,
+         g: Dynamic,
+         h: Dynamic,
+         l: Dynamic,
+         m: Dynamic,
+         n: Dynamic|
+         -> ScriptResult<Hill48> {
             lift(Hill48::new(
                 number(&f, "Hill48 F")?,
                 number(&g, "Hill48 G")?,

@@ -592,7 +592,8 @@ impl Simulation {
             e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);
             e.frictional_dissipation[c] += dissipated[c];
         }
-        let element = crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
+        let element =
+            crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
         e.elastic_energy = crate::element::total_strain_energy(
             &self.model.mesh,
             element,
@@ -600,13 +601,15 @@ impl Simulation {
             self.model.material.as_ref(),
         )
         .unwrap_or(f64::NAN);
-        e.plastic_dissipation =
-            crate::element::total_plastic_dissipation(&self.model.mesh, element, &eval.trial_points)
-                .unwrap_or(f64::NAN);
+        e.plastic_dissipation = crate::element::total_plastic_dissipation(
+            &self.model.mesh,
+            element,
+            &eval.trial_points,
+        )
+        .unwrap_or(f64::NAN);
         let input = e.tool_work + e.load_work + e.support_work;
-        let stored: f64 = e.elastic_energy
-            + e.plastic_dissipation
-            + e.frictional_dissipation.iter().sum::<f64>();
+        let stored: f64 =
+            e.elastic_energy + e.plastic_dissipation + e.frictional_dissipation.iter().sum::<f64>();
         let scale =
             (e.tool_work.abs() + e.load_work.abs() + e.support_work.abs()).max(stored.abs());
         e.relative_error = if scale > 0.0 {
