@@ -457,3 +457,45 @@ fn fbar_does_not_lock_in_nearly_incompressible_plastic_bending() {
         "32x8 without F-bar: {locked_fine}"
     );
 }
+
+/// Energy balance with plastic dissipation under small strain: with the trapezoidal rule
+/// for both the support work and the plastic dissipation, `½(σn + σn+1)·Δε` splits
+/// exactly into the elastic energy change and `½(σn + σn+1)·Δεp`, so the balance closes
+/// to the Newton tolerance on a plastic cantilever (B-bar, von Mises, Swift), although
+/// most of the work is dissipated.
+#[test]
+fn small_strain_energy_balance_includes_plastic_dissipation() {
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 2.0), [8, 1, 2]).unwrap();
+    let m = ElastoPlastic::new(
+        LinearElastic::new(YOUNG, POISSON).unwrap(),
+        Hill48::von_mises(),
+        Hardening::swift(SWIFT.0, SWIFT.1, SWIFT.2).unwrap(),
+    );
+    let mut model = Model::new(mesh, Arc::new(m)).unwrap();
+    model
+        .prescribe("x-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    for set in ["y-", "y+"] {
+        model
+            .prescribe(set, "y", ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
+    model
+        .prescribe(
+            "x+",
+            "z",
+            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, -0.5)]).unwrap(),
+        )
+        .unwrap();
+    model.settings.increments = 10;
+    model.settings.force_rel_tol = 1e-12;
+    let mut sim = Simulation::new(model).unwrap();
+    sim.run(|_, _| Ok(())).unwrap();
+    let e = sim.energy();
+    println!(
+        "support work {:.6}, elastic {:.6}, plastic {:.6}, balance {:e}",
+        e.support_work, e.elastic_energy, e.plastic_dissipation, e.relative_error
+    );
+    assert!(e.plastic_dissipation > e.elastic_energy, "mostly plastic");
+    assert!(e.relative_error.abs() < 1e-9, "{}", e.relative_error);
+}
