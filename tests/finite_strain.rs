@@ -391,6 +391,29 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
     assert!(e.relative_error.abs() < 1e-3, "{}", e.relative_error);
 }
 
+/// A plane-strain cantilever 10 x 1 x 2 (y held on both faces) of `cells` cells, clamped at
+/// x = 0, its tip face pulled down by `tip` over t in [0, 1].
+fn cantilever(cells: [usize; 3], material: ElastoPlastic, tip: f64) -> Model {
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 2.0), cells).unwrap();
+    let mut model = Model::new(mesh, Arc::new(material)).unwrap();
+    model
+        .prescribe("x-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    for set in ["y-", "y+"] {
+        model
+            .prescribe(set, "y", ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
+    model
+        .prescribe(
+            "x+",
+            "z",
+            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, -tip)]).unwrap(),
+        )
+        .unwrap();
+    model
+}
+
 /// A plane-strain cantilever (length 10, depth 2, clamped at x = 0) of a nearly
 /// incompressible (nu = 0.499) elastic-plastic von Mises material with weak linear
 /// hardening, its tip face pulled down by 1.0 (far beyond the plastic limit load), finite
@@ -406,28 +429,12 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
 #[test]
 fn fbar_does_not_lock_in_nearly_incompressible_plastic_bending() {
     let tip_force = |cells: [usize; 3], fbar: bool| {
-        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 2.0), cells).unwrap();
         let m = ElastoPlastic::new(
             LinearElastic::new(YOUNG, 0.499).unwrap(),
             Hill48::von_mises(),
             Hardening::linear(200.0, 500.0).unwrap(),
         );
-        let mut model = Model::new(mesh, Arc::new(m)).unwrap();
-        model
-            .prescribe("x-", "xyz", ScalarSchedule::constant(0.0))
-            .unwrap();
-        for set in ["y-", "y+"] {
-            model
-                .prescribe(set, "y", ScalarSchedule::constant(0.0))
-                .unwrap();
-        }
-        model
-            .prescribe(
-                "x+",
-                "z",
-                ScalarSchedule::new(vec![(0.0, 0.0), (1.0, -1.0)]).unwrap(),
-            )
-            .unwrap();
+        let mut model = cantilever(cells, m, 1.0);
         model.settings.kinematics = StrainTheory::Finite;
         model.settings.fbar = fbar;
         model.settings.increments = 10;
@@ -465,28 +472,12 @@ fn fbar_does_not_lock_in_nearly_incompressible_plastic_bending() {
 /// most of the work is dissipated.
 #[test]
 fn small_strain_energy_balance_includes_plastic_dissipation() {
-    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 2.0), [8, 1, 2]).unwrap();
     let m = ElastoPlastic::new(
         LinearElastic::new(YOUNG, POISSON).unwrap(),
         Hill48::von_mises(),
         Hardening::swift(SWIFT.0, SWIFT.1, SWIFT.2).unwrap(),
     );
-    let mut model = Model::new(mesh, Arc::new(m)).unwrap();
-    model
-        .prescribe("x-", "xyz", ScalarSchedule::constant(0.0))
-        .unwrap();
-    for set in ["y-", "y+"] {
-        model
-            .prescribe(set, "y", ScalarSchedule::constant(0.0))
-            .unwrap();
-    }
-    model
-        .prescribe(
-            "x+",
-            "z",
-            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, -0.5)]).unwrap(),
-        )
-        .unwrap();
+    let mut model = cantilever([8, 1, 2], m, 0.5);
     model.settings.increments = 10;
     model.settings.force_rel_tol = 1e-12;
     let mut sim = Simulation::new(model).unwrap();

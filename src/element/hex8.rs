@@ -217,11 +217,7 @@ impl Element<DOFS> for Hex8 {
         trial: &mut [PointState],
         material: &dyn Material,
     ) -> Result<ElementResponse<DOFS>> {
-        let x = nodes_array("ref_coords", ref_coords)?;
-        let u = nodes_array("u", u)?;
-        check_len("committed", committed.len(), POINTS)?;
-        check_len("trial", trial.len(), POINTS)?;
-        let geo = Geometry::new(&x)?;
+        let (_, u, geo) = checked_inputs(ref_coords, u, committed, trial)?;
         let ue = SVector::<f64, DOFS>::from_fn(|i, _| u[i / 3][i % 3]);
 
         let mut force = SVector::<f64, DOFS>::zeros();
@@ -252,6 +248,22 @@ impl Element<DOFS> for Hex8 {
             .dvol
             .to_vec())
     }
+}
+
+/// Nodal arrays and reference geometry for [`Element::evaluate`], after checking every
+/// slice length.
+pub(super) fn checked_inputs(
+    ref_coords: &[Vec3],
+    u: &[Vec3],
+    committed: &[PointState],
+    trial: &[PointState],
+) -> Result<([Vec3; NODES], [Vec3; NODES], Geometry)> {
+    let x = nodes_array("ref_coords", ref_coords)?;
+    let u = nodes_array("u", u)?;
+    check_len("committed", committed.len(), POINTS)?;
+    check_len("trial", trial.len(), POINTS)?;
+    let geo = Geometry::new(&x)?;
+    Ok((x, u, geo))
 }
 
 pub(super) fn check_len(what: &str, len: usize, expected: usize) -> Result<()> {

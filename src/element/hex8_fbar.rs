@@ -52,9 +52,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::hex8::{
-    check_len, jacobian, nodes_array, shape_derivatives, Geometry, DOFS, NODES, POINTS,
-};
+use super::hex8::{checked_inputs, jacobian, shape_derivatives, DOFS, NODES, POINTS};
 use super::{prefix, Element, ElementResponse, Hex8};
 use crate::geometry::{Mat3, Vec3};
 use crate::material::{stress_to_tensor, Material, PointState};
@@ -128,11 +126,7 @@ impl Element<DOFS> for Hex8FBar {
         trial: &mut [PointState],
         material: &dyn Material,
     ) -> Result<ElementResponse<DOFS>> {
-        let x = nodes_array("ref_coords", ref_coords)?;
-        let u = nodes_array("u", u)?;
-        check_len("committed", committed.len(), POINTS)?;
-        check_len("trial", trial.len(), POINTS)?;
-        let geo = Geometry::new(&x)?;
+        let (x, u, geo) = checked_inputs(ref_coords, u, committed, trial)?;
         let b0 = centre_gradients(&x)?;
         let (f0_inv_t, j0) = inverse_transpose(&gradient(&u, &b0), "the element centre")?;
         let g0: [Vec3; NODES] = std::array::from_fn(|a| f0_inv_t * b0[a]);
