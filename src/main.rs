@@ -31,6 +31,10 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Continue from a checkpoint (written with settings checkpoint_every, sim.checkpoint,
+        /// or at a stop): the script builds the model again, then the state is loaded.
+        #[arg(long, value_name = "CHECKPOINT")]
+        restart: Option<PathBuf>,
     },
     /// Interactive stepping; loads SCRIPT's scene first if given.
     Repl {
@@ -56,6 +60,7 @@ fn main() -> ExitCode {
             out,
             set,
             quiet,
+            restart,
         } => (|| {
             let overrides = set
                 .iter()
@@ -64,6 +69,7 @@ fn main() -> ExitCode {
             let host = HostOptions {
                 out_dir: out.unwrap_or_else(|| default_out(Some(&script))),
                 progress: !quiet,
+                restart,
                 ..HostOptions::default()
             };
             script::run_file(&script, &overrides, &host)?;

@@ -123,3 +123,132 @@ fn jacobian_matches_finite_differences_on_a_sphere() {
     let s = Sphere::new(Vec3::new(0.1, 0.0, -1.5), 1.5).unwrap();
     check_all_statuses("sphere", &moved_tool(Arc::new(s)));
 }
+
+/// As [`check_all_statuses`], with every base point's foot at the surface point nearest to
+/// `probe` (so that the stencil stays where the test puts it: inside a patch, near a seam):
+/// the point moves along the normal only and the reference point carries the tangential
+/// offset (the same `x - x_ref` as above).
+fn check_statuses_at_foot(name: &str, tool: &Tool, probe: Vec3) {
+    let pose = tool.pose(0.5);
+    let p = tool.project(&pose, &probe, None).unwrap();
+    let (foot, n) = (p.foot, p.normal);
+    let t1 = n.cross(&Vec3::new(0.3, 0.9, 0.1)).normalize();
+    let cases = [
+        (ContactStatus::Gap, n * 0.2, Vec3::zeros(), Vec3::zeros()),
+        (
+            ContactStatus::Stick,
+            -n * 0.01,
+            -n * 0.01 + t1 * 0.0005,
+            -n * 10.0,
+        ),
+        (
+            ContactStatus::Slip,
+            -n * 0.02,
+            -n * 0.02 + t1 * 0.29,
+            -n * 3.0 + t1 * 0.5,
+        ),
+    ];
+    for (status, offset, x_minus_ref, l) in cases {
+        let x = foot + offset;
+        let m = fd_mismatch(tool, x, l, x - x_minus_ref, status);
+        println!("{name:24} {status:?}: relative mismatch {m:.2e}");
+        assert!(
+            m < 1e-6,
+            "{name} {status:?}: Jacobian differs from finite differences by {m:.2e}"
+        );
+    }
+}
+
+/// The same tool rotated by 40° about a skew axis over t in [0, 1] (20° at t = 0.5) on top
+/// of its translation.
+fn rotated(tool: &Tool) -> Tool {
+    let mut t = tool.clone();
+    t.schedule = t
+        .schedule
+        .clone()
+        .with_rotation(
+            Vec3::new(0.5, -0.3, 0.2),
+            Vec3::new(0.3, 1.0, 0.4),
+            vec![(0.0, 0.0), (1.0, 40.0)],
+        )
+        .unwrap();
+    t
+}
+
+/// Patch tools: inside a torus patch of the square-cup punch's nose corner, 1e-4 from its
+/// seams with the nose-radius cylinder and with the flat nose (where the curvature jumps,
+/// so the stencil of 1e-6 must not cross), in the flat nose where two patches overlap,
+/// and exactly on a seam of a cylinder of quarter patches (curvature continuous there);
+/// each with the tool translated, and translated and rotated.
+#[test]
+fn jacobian_matches_finite_differences_on_patch_tools() {
+    use tribo::geometry::builders::{punch_patches, Extent, PunchSpec};
+    use tribo::geometry::{BezierPatch, PatchSurface};
+    let spec = PunchSpec {
+        side: 70.0,
+        plan_corner_radius: 10.0,
+        nose_radius: 8.0,
+        wall_height: 20.0,
+        level: 0.0,
+    };
+    let punch = PatchSurface::new(punch_patches(&spec, Extent::Full).unwrap()).unwrap();
+    let punch = moved_tool(Arc::new(punch));
+    // Nose corner: torus of tube-centre circle radius 2 around (25, 25), tube radius 8 at
+    // height 8. A point at plan angle psi, tube angle phi (from the outward radial, -90°
+    // is straight down) and distance 0.5 outside, in the tool's frame at t = 0.5.
+    let corner = |psi: f64, phi: f64| {
+        let (psi, phi) = (psi.to_radians(), phi.to_radians());
+        let radial = Vec3::new(psi.cos(), psi.sin(), 0.0);
+        let n = radial * phi.cos() + Vec3::z() * phi.sin();
+        let local = Vec3::new(25.0, 25.0, 8.0) + radial * 2.0 + n * 8.5;
+        punch.pose(0.5).to_global_point(&local)
+    };
+    let seam_angle = 1e-4f64.to_degrees() / 8.0; // 1e-4 of arc on the tube, in degrees
+    let quarter_cylinder = (0..4)
+        .map(|q| {
+            let start = q as f64 * std::f64::consts::FRAC_PI_2;
+            BezierPatch::quarter_cylinder(
+                Vec3::new(0.0, -3.0, -2.0),
+                Vec3::new(0.2, 1.0, 0.1),
+                Vec3::x(),
+                start,
+                2.0,
+                6.0,
+            )
+        })
+        .collect::<tribo::Result<Vec<_>>>()
+        .unwrap();
+    let cylinder = moved_tool(Arc::new(PatchSurface::new(quarter_cylinder).unwrap()));
+    // The quarter cylinder's seam at angle 90° from x around the axis, mid-length.
+    let cylinder_seam = {
+        let a = Vec3::new(0.2, 1.0, 0.1).normalize();
+        let f1 = (Vec3::x() - a * a.x).normalize();
+        let local = Vec3::new(0.0, -3.0, -2.0) + a * 3.0 + a.cross(&f1) * 2.5;
+        cylinder.pose(0.5).to_global_point(&local)
+    };
+    let pose = punch.pose(0.5);
+    let cases = [
+        ("punch torus interior", &punch, corner(40.0, -50.0)),
+        ("punch torus near wall", &punch, corner(40.0, -seam_angle)),
+        (
+            "punch torus near flat",
+            &punch,
+            corner(40.0, -90.0 + seam_angle),
+        ),
+        ("punch torus near side", &punch, corner(seam_angle, -40.0)),
+        (
+            "punch flat overlap",
+            &punch,
+            pose.to_global_point(&Vec3::new(10.0, 10.0, -0.5)),
+        ),
+        ("quarter cylinder seam", &cylinder, cylinder_seam),
+    ];
+    for (name, tool, probe) in cases {
+        check_statuses_at_foot(name, tool, probe);
+        let turned = rotated(tool);
+        // The same material point of the tool, seen at the rotated pose.
+        let local = tool.pose(0.5).to_local(&probe);
+        let probe_turned = turned.pose(0.5).to_global_point(&local);
+        check_statuses_at_foot(&format!("{name} (rotated)"), &turned, probe_turned);
+    }
+}

@@ -40,7 +40,7 @@
 use crate::geometry::{Mat3, Projection, Vec3};
 
 /// Contact status of one node, decided by the augmented multiplier.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum ContactStatus {
     #[default]
     Gap,
@@ -93,6 +93,10 @@ pub struct OperatorParams {
     /// frictional work (implicit friction update); zero otherwise.
     pub dmu_dx: Vec3,
     pub dmu_dlambda: Vec3,
+    /// Status imposed instead of the one the augmented multiplier selects (anti-cycling,
+    /// see `solver::cycling`); a forced slip with a vanishing tangential trial force falls
+    /// back to stick, whose force is then the same.
+    pub forced: Option<ContactStatus>,
 }
 
 impl OperatorParams {
@@ -104,6 +108,7 @@ impl OperatorParams {
             curvature,
             dmu_dx: Vec3::zeros(),
             dmu_dlambda: Vec3::zeros(),
+            forced: None,
         }
     }
 }
@@ -140,14 +145,26 @@ pub fn alart_curnier(
     let dsigma_x = a * r;
     let dsigma_n_x = n.transpose() * dsigma_x + sigma.transpose() * g_mat;
 
-    let (status, f_equi, equi_x, equi_lambda) = if sigma_n > 0.0 {
+    let natural = if sigma_n > 0.0 {
+        ContactStatus::Gap
+    } else if sigma_t.norm() + mu * sigma_n <= 0.0 {
+        ContactStatus::Stick
+    } else {
+        ContactStatus::Slip
+    };
+    let chosen = match params.forced {
+        Some(ContactStatus::Slip) if sigma_t.norm() == 0.0 => ContactStatus::Stick,
+        Some(s) => s,
+        None => natural,
+    };
+    let (status, f_equi, equi_x, equi_lambda) = if chosen == ContactStatus::Gap {
         (
             ContactStatus::Gap,
             Vec3::zeros(),
             Mat3::zeros(),
             Mat3::zeros(),
         )
-    } else if sigma_t.norm() + mu * sigma_n <= 0.0 {
+    } else if chosen == ContactStatus::Stick {
         (ContactStatus::Stick, sigma, dsigma_x, ident)
     } else {
         let st_norm = sigma_t.norm();

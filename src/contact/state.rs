@@ -4,7 +4,7 @@ use super::{ContactStatus, FrictionInput};
 use crate::geometry::{SurfaceHint, Vec3};
 
 /// The committed state of one (tool, node) contact pair.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct ContactNodeState {
     /// Contact multiplier: the force the node exerts on the tool (lambda_n <= 0 in contact).
     pub lambda: Vec3,

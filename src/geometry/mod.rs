@@ -8,10 +8,14 @@
 use nalgebra::{Matrix3, Vector3};
 
 pub mod bezier;
+pub mod builders;
+pub mod bvh;
 mod check;
 pub mod cylinder;
 pub mod patch_surface;
+pub mod patch_table;
 pub mod plane;
+pub mod seams;
 pub mod sphere;
 #[cfg(test)]
 pub(crate) mod testutil;
@@ -22,6 +26,7 @@ pub use bezier::{BezierPatch, PatchPoint};
 pub use cylinder::Cylinder;
 pub use patch_surface::PatchSurface;
 pub use plane::Plane;
+pub use seams::SeamReport;
 pub use sphere::Sphere;
 
 pub type Vec3 = Vector3<f64>;
@@ -29,7 +34,7 @@ pub type Mat3 = Matrix3<f64>;
 
 /// Where on a multi-piece surface a foot point lies (patch index and parameters); used to
 /// warm-start the next projection. Analytic surfaces ignore it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SurfaceHint {
     pub patch: usize,
     pub u: f64,
@@ -61,4 +66,9 @@ pub trait RigidSurface: std::fmt::Debug {
 
     /// A short human-readable description ("cylinder r=5 ...") for logs and errors.
     fn describe(&self) -> String;
+
+    /// The patch surface behind this surface, if it is one (for its seam report).
+    fn as_patch_surface(&self) -> Option<&PatchSurface> {
+        None
+    }
 }

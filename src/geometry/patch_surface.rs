@@ -29,6 +29,8 @@
 //! `n` is continuous where the foot passes from the inside of the patch to its edge.
 
 use super::bezier::{BezierPatch, PatchPoint};
+use super::bvh::{box_distance, Bvh};
+use super::seams::{seam_report, SeamReport};
 use super::*;
 use crate::{Error, Result};
 use nalgebra::{Matrix2, Matrix3x2};
@@ -43,10 +45,15 @@ pub struct PatchSurface {
     patches: Vec<BezierPatch>,
     /// Control-point bounding boxes, to skip patches that cannot hold a closer foot.
     boxes: Vec<(Vec3, Vec3)>,
+    /// Tree over `boxes`: candidate patches nearest-first, pruned by the best distance.
+    bvh: Bvh,
+    /// Search with the tree (default) or by sorting all boxes (kept to cross-check it).
+    use_bvh: bool,
     /// Diagonal of the whole surface's box: the length scale of tolerances.
     scale: f64,
+    /// Worst gap and kink where patches meet, measured at construction.
+    seams: SeamReport,
 }
-
 /// Which bounds of `[0, 1]^2` hold the foot: the strictly active constraints.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Kind {
@@ -72,16 +79,17 @@ impl Kind {
 
 /// Closest point of `x` on one patch.
 #[derive(Clone, Copy, Debug)]
-struct Local {
-    u: f64,
-    v: f64,
-    e: PatchPoint,
-    dist: f64,
+pub(crate) struct Local {
+    pub(crate) u: f64,
+    pub(crate) v: f64,
+    pub(crate) e: PatchPoint,
+    pub(crate) dist: f64,
     kind: Kind,
 }
 
 impl PatchSurface {
-    /// Errs if there is no patch.
+    /// Errs if there is no patch, or if two patches meeting at a seam face opposite ways
+    /// (see [`seam_report`]). The seam report is kept ([`PatchSurface::seams`]).
     pub fn new(patches: Vec<BezierPatch>) -> Result<PatchSurface> {
         if patches.is_empty() {
             return Err(Error::input("patch surface patch count", 0, "must be >= 1"));
@@ -91,29 +99,99 @@ impl PatchSurface {
             (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
             |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)),
         );
-        Ok(PatchSurface {
+        let mut surface = PatchSurface {
+            bvh: Bvh::new(&boxes),
             patches,
             boxes,
+            use_bvh: true,
             scale: (hi - lo).norm(),
-        })
+            seams: SeamReport::default(),
+        };
+        surface.seams = seam_report(&surface)?;
+        Ok(surface)
+    }
+
+    /// As [`PatchSurface::new`], and `outside` (a point the user knows to be outside the
+    /// tool) must lie on the outer side: a positive gap. Otherwise the patches face inward
+    /// and the error says so.
+    pub fn with_outside_point(patches: Vec<BezierPatch>, outside: Vec3) -> Result<PatchSurface> {
+        let outside = finite_vec3("patch surface outside point", &outside)?;
+        let surface = PatchSurface::new(patches)?;
+        match surface.project(&outside, None) {
+            Some(p) if p.gap > 0.0 => Ok(surface),
+            Some(p) => Err(Error::input(
+                "patch surface outside point",
+                fmt_vec3(&outside),
+                &format!(
+                    "is on the inner side of patch {} (signed gap {:.6e}): the patches face \
+                     inward; flip them or give a point outside the tool",
+                    p.hint.patch, p.gap
+                ),
+            )),
+            None => Err(Error::input(
+                "patch surface outside point",
+                fmt_vec3(&outside),
+                "has no defined projection on the surface",
+            )),
+        }
     }
 
     pub fn patches(&self) -> &[BezierPatch] {
         &self.patches
     }
 
+    /// Worst position gap and normal kink across the seams, from construction.
+    pub fn seams(&self) -> &SeamReport {
+        &self.seams
+    }
+
+    /// Diagonal of the surface's bounding box.
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// The same surface searched by sorting every patch box instead of the tree: slower,
+    /// kept to check the tree gives the same answers.
+    pub fn without_bvh(mut self) -> PatchSurface {
+        self.use_bvh = false;
+        self
+    }
+
     /// Lower bound of the distance from `x` to patch `k` (its box).
     fn box_distance(&self, k: usize, x: &Vec3) -> f64 {
         let (lo, hi) = &self.boxes[k];
-        let below = (lo - x).sup(&Vec3::zeros());
-        let above = (x - hi).sup(&Vec3::zeros());
-        (below + above).norm()
+        box_distance(lo, hi, x)
+    }
+
+    /// Patches in non-decreasing box distance from `x`, while `visit` (which returns the
+    /// current pruning bound) accepts them.
+    pub(crate) fn nearest_patches(
+        &self,
+        x: &Vec3,
+        bound: f64,
+        mut visit: impl FnMut(usize, f64) -> f64,
+    ) {
+        if self.use_bvh {
+            self.bvh.nearest_first(x, bound, visit);
+            return;
+        }
+        let mut order: Vec<(f64, usize)> = (0..self.patches.len())
+            .map(|k| (self.box_distance(k, x), k))
+            .collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut bound = bound;
+        for (d, k) in order {
+            if d > bound {
+                break;
+            }
+            bound = visit(k, d);
+        }
     }
 
     /// Closest point on patch `k`, from `start` (warm) or from the best of a coarse grid.
-    fn closest_on_patch(&self, k: usize, x: &Vec3, start: Option<(f64, f64)>) -> Local {
+    pub(crate) fn closest_on_patch(&self, k: usize, x: &Vec3, start: Option<(f64, f64)>) -> Local {
         let patch = &self.patches[k];
-        let dist2 = |u: f64, v: f64| (patch.evaluate(u, v).point - x).norm_squared();
+        let dist2 = |u: f64, v: f64| (patch.point(u, v) - x).norm_squared();
         let (mut u, mut v) = match start {
             Some((u, v)) => (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0)),
             None => {
@@ -326,37 +404,41 @@ impl RigidSurface for PatchSurface {
             hint.filter(|h| h.patch < self.patches.len() && h.u.is_finite() && h.v.is_finite());
         let mut best: Option<(usize, Local)> =
             hinted.map(|h| (h.patch, self.closest_on_patch(h.patch, x, Some((h.u, h.v)))));
-        let mut order: Vec<(f64, usize)> = (0..self.patches.len())
-            .filter(|&k| Some(k) != hinted.map(|h| h.patch))
-            .map(|k| (self.box_distance(k, x), k))
-            .collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (lower_bound, k) in order {
-            if let Some((_, b)) = &best {
-                if lower_bound > b.dist + tol {
-                    break;
-                }
+        let hinted_patch = hinted.map(|h| h.patch);
+        // Pruning bound: a candidate replaces the best only if closer by the hysteresis
+        // margin, or equally close (within tol) with a better-ranked foot. An interior best
+        // cannot be out-ranked, so then no box farther than its distance minus the margin
+        // can hold a winner (less 1e-14 of the size, so that a flat patch's box, exactly
+        // at the distance, is skipped despite the rounding of the foot's distance).
+        let bound_of = |best: &Option<(usize, Local)>| match best {
+            None => f64::INFINITY,
+            Some((kb, b)) if b.kind == Kind::Interior => {
+                let margin = if Some(*kb) == hinted_patch { tol } else { 0.0 };
+                b.dist - margin - 1e-14 * self.scale
             }
-            let c = self.closest_on_patch(k, x, None);
-            let replace = match &best {
-                None => true,
-                Some((kb, b)) => {
-                    let margin = if Some(*kb) == hinted.map(|h| h.patch) {
-                        tol
-                    } else {
-                        0.0
-                    };
-                    if c.kind.rank() != b.kind.rank() && (c.dist - b.dist).abs() <= tol {
-                        c.kind.rank() < b.kind.rank()
-                    } else {
-                        c.dist < b.dist - margin
+            Some((_, b)) => b.dist + tol,
+        };
+        let bound = bound_of(&best);
+        self.nearest_patches(x, bound, |k, _| {
+            if Some(k) != hinted_patch {
+                let c = self.closest_on_patch(k, x, None);
+                let replace = match &best {
+                    None => true,
+                    Some((kb, b)) => {
+                        let margin = if Some(*kb) == hinted_patch { tol } else { 0.0 };
+                        if c.kind.rank() != b.kind.rank() && (c.dist - b.dist).abs() <= tol {
+                            c.kind.rank() < b.kind.rank()
+                        } else {
+                            c.dist < b.dist - margin
+                        }
                     }
+                };
+                if replace {
+                    best = Some((k, c));
                 }
-            };
-            if replace {
-                best = Some((k, c));
             }
-        }
+            bound_of(&best)
+        });
         let (k, loc) = best?;
         self.finish(k, &loc, x)
     }
@@ -367,6 +449,10 @@ impl RigidSurface for PatchSurface {
             self.patches.len(),
             self.scale
         )
+    }
+
+    fn as_patch_surface(&self) -> Option<&PatchSurface> {
+        Some(self)
     }
 }
 

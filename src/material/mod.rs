@@ -56,7 +56,7 @@ pub type Tangent = Matrix6<f64>;
 /// not use are carried over unchanged. Construct with [`PointState::default`] (or
 /// [`Material::initial_state`]) and struct-update syntax, so that fields added for later
 /// materials do not break existing code.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PointState {
     /// Cauchy stress (Voigt, tensor components). Equal to the small-strain stress for
     /// small-strain materials.

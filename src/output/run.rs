@@ -13,7 +13,8 @@ pub struct RunOutput {
     folder: OutputFolder,
     pvd: PvdSeries,
     history: HistoryCsv,
-    frames: usize,
+    /// Time of each frame written (frame i is frames/frame_{i:04}.vtu).
+    frame_times: Vec<f64>,
 }
 
 impl RunOutput {
@@ -30,6 +31,15 @@ impl RunOutput {
             "contact_residual",
             "active_nodes",
             "slipping_nodes",
+            "rejected_steps",
+            "line_search_cuts",
+            "cycling_nodes",
+            "frozen_nodes",
+            "step_limit",
+            "next_dt",
+            "max_plastic_strain_increment",
+            "max_rotation_increment",
+            "max_slip_increment",
         ]
         .iter()
         .map(|s| s.to_string())
@@ -57,16 +67,60 @@ impl RunOutput {
             folder,
             pvd,
             history,
-            frames: 0,
+            frame_times: Vec::new(),
         })
+    }
+
+    /// Continues the output of a restarted run in `dir`: history.csv is written again from
+    /// the restored increment reports, and the frames the run had written before the
+    /// checkpoint (`frame_times`) are listed in the .pvd when their files are there.
+    pub fn resume(dir: &Path, sim: &Simulation, frame_times: &[f64]) -> Result<Self> {
+        let mut out = RunOutput::create(dir, sim)?;
+        for (i, &t) in frame_times.iter().enumerate() {
+            let name = format!("frames/frame_{i:04}.vtu");
+            if out.folder.resolve(&name)?.is_file() {
+                out.pvd.add(t, &name)?;
+            }
+        }
+        out.frame_times = frame_times.to_vec();
+        out.record(sim)?;
+        Ok(out)
+    }
+
+    /// Times of the frames written so far.
+    pub fn frame_times(&self) -> &[f64] {
+        &self.frame_times
+    }
+
+    /// Writes the committed state as a checkpoint at `relative` (below the output folder).
+    pub fn write_checkpoint(&self, sim: &Simulation, relative: &str) -> Result<std::path::PathBuf> {
+        let path = self.folder.resolve_for_write(relative)?;
+        let json =
+            crate::solver::checkpoint::Checkpoint::of(sim, self.frame_times.clone()).to_json()?;
+        super::write_atomic(&path, json.as_bytes())?;
+        Ok(path)
     }
 
     pub fn folder(&self) -> &OutputFolder {
         &self.folder
     }
 
-    /// Appends the increment's row to history.csv.
-    pub fn record(&mut self, _sim: &Simulation, r: &IncrementReport) -> Result<()> {
+    /// Appends a row to history.csv for every increment of `sim.history` not written yet
+    /// (a fixed step cut back into several increments gives several rows). After a
+    /// rollback the file is written again from the remaining increments.
+    pub fn record(&mut self, sim: &Simulation) -> Result<()> {
+        if self.history.rows() > sim.history.len() {
+            let path = self.history.path().to_path_buf();
+            let columns = self.history.columns().to_vec();
+            self.history = HistoryCsv::create(path, &columns)?;
+        }
+        for r in &sim.history[self.history.rows()..] {
+            self.record_one(r)?;
+        }
+        Ok(())
+    }
+
+    fn record_one(&mut self, r: &IncrementReport) -> Result<()> {
         let last = r.residuals.last();
         let mut row = vec![
             r.index as f64,
@@ -78,6 +132,15 @@ impl RunOutput {
             last.map_or(0.0, |x| x.contact),
             r.active_nodes as f64,
             r.slipping_nodes as f64,
+            r.rejected as f64,
+            r.line_search_cuts as f64,
+            r.cycling.len() as f64,
+            r.cycling.iter().filter(|c| c.frozen.is_some()).count() as f64,
+            r.limit.code(),
+            r.next_dt,
+            r.measures.plastic_strain,
+            r.measures.rotation,
+            r.measures.slip,
         ];
         for f in &r.tool_forces {
             row.extend_from_slice(f);
@@ -97,11 +160,11 @@ impl RunOutput {
 
     /// Writes the committed state as frames/frame_NNNN.vtu and adds it to frames.pvd.
     pub fn write_frame(&mut self, sim: &Simulation) -> Result<()> {
-        let name = format!("frames/frame_{:04}.vtu", self.frames);
+        let name = format!("frames/frame_{:04}.vtu", self.frame_times.len());
         let path = self.folder.resolve_for_write(&name)?;
         write_vtu(&path, &frame(sim))?;
         self.pvd.add(sim.time(), &name)?;
-        self.frames += 1;
+        self.frame_times.push(sim.time());
         Ok(())
     }
 
@@ -160,7 +223,11 @@ impl RunOutput {
             },
             "energy": sim.energy(),
             "tools": tools,
-            "frames": self.frames,
+            "frames": self.frame_times.len(),
+            "rejected_steps": sim.history.iter().map(|r| r.rejected).sum::<usize>(),
+            "line_search_cuts": sim.history.iter().map(|r| r.line_search_cuts).sum::<usize>(),
+            "increments_with_cycling": sim.history.iter().filter(|r| !r.cycling.is_empty()).count(),
+            "step_control": format!("{:?}", settings.stepping.mode).to_lowercase(),
         });
         write_summary(&self.folder.resolve_for_write("summary.json")?, &summary)
     }

@@ -428,9 +428,24 @@ fn register_tools(engine: &mut Engine) {
     engine.register_fn("tool", |name: &str, s: ScriptSurface| Tool::new(name, s.0));
     // tool.path([[t, dx, dy, dz], ...]): piecewise-linear translation against time.
     engine.register_fn("path", |t: &mut Tool, table: Array| -> ScriptResult<Tool> {
-        t.schedule = translation_schedule(&table)?;
+        let rotation = t.schedule.rotation().cloned();
+        t.schedule = translation_schedule(&table)?.keeping_rotation(rotation);
         Ok(t.clone())
     });
+    // tool.rotate(axis_point, axis, [[t, angle_deg], ...]): rotation about a fixed axis by a
+    // piecewise-linear angle, applied before the path's translation.
+    engine.register_fn(
+        "rotate",
+        |t: &mut Tool, point: Array, axis: Array, table: Array| -> ScriptResult<Tool> {
+            let rows = schedule_points(&table, 2)?;
+            t.schedule = lift(t.schedule.clone().with_rotation(
+                vec3(&point, "rotation axis point")?,
+                vec3(&axis, "rotation axis")?,
+                rows.iter().map(|r| (r[0], r[1])).collect(),
+            ))?;
+            Ok(t.clone())
+        },
+    );
     engine.register_fn("friction", |t: &mut Tool, law: FrictionLaw| -> Tool {
         t.friction = law;
         t.clone()

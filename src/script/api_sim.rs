@@ -7,7 +7,8 @@ use crate::contact::{Enforcement, FrameUpdate};
 use crate::contact::{FrictionInput, FrictionLaw};
 use crate::mesh::Mesh;
 use crate::output::RunOutput;
-use crate::solver::{IncrementReport, Model, Simulation};
+use crate::solver::checkpoint::Checkpoint;
+use crate::solver::{AntiCycling, IncrementReport, Model, Simulation, SolverSettings, StepMode};
 use crate::tool::Tool;
 use crate::Error;
 use rhai::{Array, Dynamic, Engine, FnPtr, Map, NativeCallContext};
@@ -21,6 +22,8 @@ pub struct SimState {
     sim: Option<Simulation>,
     output: Option<RunOutput>,
     output_every: usize,
+    /// Write checkpoints/checkpoint_NNNN.json every this many increments (0: never).
+    checkpoint_every: usize,
     host: Rc<HostOptions>,
     started: Option<Instant>,
     /// Per converged increment: (index, time, per tool, per candidate [work, mu, status]).
@@ -82,12 +85,27 @@ impl SimState {
             let Some(model) = self.model.clone() else {
                 return runtime_error("the simulation has no model");
             };
-            let sim = lift(Simulation::new(model))?;
+            let mut sim = lift(Simulation::new(model))?;
             self.model = None;
-            if self.output_every > 0 {
+            let frame_times = match self.host.restart.as_ref() {
+                Some(path) if !self.host.restart_used.get() => {
+                    self.host.restart_used.set(true);
+                    Some(lift(load_checkpoint(path, &mut sim))?)
+                }
+                _ => None,
+            };
+            if self.output_every > 0 || self.checkpoint_every > 0 {
                 let dir = self.host.out_dir.clone();
-                let mut out = lift(RunOutput::create(&dir, &sim))?;
-                lift(out.write_frame(&sim))?;
+                let out = match &frame_times {
+                    Some(times) => lift(RunOutput::resume(&dir, &sim, times))?,
+                    None => {
+                        let mut out = lift(RunOutput::create(&dir, &sim))?;
+                        if self.output_every > 0 {
+                            lift(out.write_frame(&sim))?;
+                        }
+                        out
+                    }
+                };
                 self.output = Some(out);
             }
             self.sim = Some(sim);
@@ -104,11 +122,24 @@ impl SimState {
         match sim.step() {
             Ok(report) => Ok(report),
             Err(err) => {
+                let mut err = err;
                 if let Some(out) = self.output.as_mut() {
                     let wall = self
                         .started
                         .map(|s| s.elapsed().as_secs_f64())
                         .unwrap_or(0.0);
+                    // The last converged state, to restart from with other settings.
+                    match out.write_checkpoint(sim, "checkpoints/final.json") {
+                        Ok(path) => {
+                            err = Error::NoConvergence(format!(
+                                "{}; last converged state (t = {}) saved in {}",
+                                err.to_string().trim_start_matches("no convergence: "),
+                                sim.time(),
+                                path.display()
+                            ))
+                        }
+                        Err(e) => eprintln!("warning: cannot write the final checkpoint: {e}"),
+                    }
                     let _ = out.write_summary(sim, wall, Some(&err.to_string()));
                 }
                 fail(err)
@@ -120,10 +151,25 @@ impl SimState {
     fn record_step(&mut self, report: &IncrementReport) -> ScriptResult<()> {
         let every = self.output_every;
         let sim = self.sim.as_ref().expect("started");
+        if self.host.warnings {
+            for w in &report.warnings {
+                eprintln!(
+                    "warning: increment {} (t = {}): {w}",
+                    report.index, report.time
+                );
+            }
+        }
         if let Some(out) = self.output.as_mut() {
-            lift(out.record(sim, report))?;
+            lift(out.record(sim))?;
             if every > 0 && (report.index % every == 0 || sim.is_finished()) {
                 lift(out.write_frame(sim))?;
+            }
+            let ck = self.checkpoint_every;
+            if ck > 0 && (report.index % ck == 0 || sim.is_finished()) {
+                lift(out.write_checkpoint(
+                    sim,
+                    &format!("checkpoints/checkpoint_{:04}.json", report.index),
+                ))?;
             }
         }
         let snapshot = (0..sim.model.contacts.len())
@@ -156,6 +202,30 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     m.insert("time".into(), Dynamic::from(r.time));
     m.insert("iterations".into(), Dynamic::from(r.iterations as i64));
     m.insert("cutbacks".into(), Dynamic::from(r.cutbacks as i64));
+    m.insert("dt".into(), Dynamic::from(r.dt));
+    m.insert("rejected_steps".into(), Dynamic::from(r.rejected as i64));
+    m.insert(
+        "line_search_cuts".into(),
+        Dynamic::from(r.line_search_cuts as i64),
+    );
+    m.insert(
+        "cycling_nodes".into(),
+        Dynamic::from(
+            r.cycling
+                .iter()
+                .map(|c| Dynamic::from(c.node as i64))
+                .collect::<Array>(),
+        ),
+    );
+    m.insert(
+        "warnings".into(),
+        Dynamic::from(
+            r.warnings
+                .iter()
+                .map(|w| Dynamic::from(w.clone()))
+                .collect::<Array>(),
+        ),
+    );
     m.insert("active_nodes".into(), Dynamic::from(r.active_nodes as i64));
     m.insert(
         "slipping_nodes".into(),
@@ -188,11 +258,80 @@ fn tool_names(s: &SimState) -> Vec<String> {
     model.contacts.iter().map(|c| c.tool.name.clone()).collect()
 }
 
-fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult<()> {
-    let s = &mut model.settings;
+/// Reads a checkpoint file into `sim`; returns the times of the frames written before it.
+fn load_checkpoint(path: &std::path::Path, sim: &mut Simulation) -> crate::Result<Vec<f64>> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let ck = Checkpoint::from_json(&text, &path.display().to_string())?;
+    let times = ck.frame_times.clone();
+    ck.restore(sim)?;
+    Ok(times)
+}
+
+/// Output knobs of the script layer.
+struct Knobs {
+    output_every: usize,
+    checkpoint_every: usize,
+}
+
+fn choice<'a>(v: &Dynamic, key: &str, options: &[&'a str]) -> ScriptResult<&'a str> {
+    let text = v.clone().into_string().unwrap_or_else(|t| format!("({t})"));
+    match options.iter().find(|o| **o == text) {
+        Some(o) => Ok(o),
+        None => runtime_error(format!(
+            "{key} = '{text}' must be one of {}",
+            options
+                .iter()
+                .map(|o| format!("\"{o}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}
+
+fn flag(v: &Dynamic, key: &str) -> ScriptResult<bool> {
+    v.as_bool()
+        .map_err(|t| format!("{key} must be true or false, got {t}"))
+        .or_else(runtime_error)
+}
+
+fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptResult<()> {
     for (key, v) in spec {
         let num = |what: &str| number(v, what);
+        let count = |what: &str| -> ScriptResult<usize> {
+            let x = number(v, what)?;
+            if x >= 0.0 && x.fract() == 0.0 && x < 1e12 {
+                Ok(x as usize)
+            } else {
+                fail(Error::input(what, x, "must be a whole number >= 0"))
+            }
+        };
+        let step = &mut s.stepping;
         match key.as_str() {
+            "step_control" => {
+                step.mode = match choice(v, key, &["fixed", "adaptive"])? {
+                    "fixed" => StepMode::Fixed,
+                    _ => StepMode::Adaptive,
+                }
+            }
+            "dt_min" => step.dt_min = Some(num("dt_min")?),
+            "dt_max" => step.dt_max = Some(num("dt_max")?),
+            "dt_initial" => step.dt_initial = Some(num("dt_initial")?),
+            "max_plastic_strain_increment" => step.max_plastic_strain_increment = num(key)?,
+            "max_rotation_increment" => step.max_rotation_increment = num(key)?,
+            "max_slip_increment" => step.max_slip_increment = num(key)?,
+            "target_iterations" => step.target_iterations = count(key)?,
+            "step_growth" => step.growth = num(key)?,
+            "line_search" => step.line_search = flag(v, key)?,
+            "anti_cycling" => {
+                step.anti_cycling = match choice(v, key, &["freeze", "damp", "off"])? {
+                    "freeze" => AntiCycling::Freeze,
+                    "damp" => AntiCycling::Damp,
+                    _ => AntiCycling::Off,
+                }
+            }
+            "cycle_flips" => step.cycle_flips = count(key)?,
+            "rollback_depth" => step.rollback_depth = count(key)?,
+            "checkpoint_every" => st.checkpoint_every = count(key)?,
             "increments" => s.increments = num("increments")? as usize,
             "end_time" => s.end_time = num("end_time")?,
             "max_iterations" => s.max_iterations = num("max_iterations")? as usize,
@@ -200,7 +339,7 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
             "force_tolerance" => s.force_rel_tol = num("force_tolerance")?,
             "force_abs_tolerance" => s.force_abs_tol = num("force_abs_tolerance")?,
             "contact_tolerance" => s.contact_tol = num("contact_tolerance")?,
-            "output_every" => *st = num("output_every")? as usize,
+            "output_every" => st.output_every = count("output_every")?,
             "eliminate_multipliers" => {
                 s.eliminate_multipliers = v
                     .as_bool()
@@ -247,7 +386,7 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, kinematics, fbar)"
+                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth, kinematics, fbar)"
                 ))
             }
         }
@@ -265,11 +404,11 @@ fn apply_settings(model: &mut Model, st: &mut usize, spec: &Map) -> ScriptResult
         ("force_tolerance", s.force_rel_tol),
         ("contact_tolerance", s.contact_tol),
     ] {
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return fail(Error::input(what, v, "must be > 0"));
         }
     }
-    Ok(())
+    lift(s.stepping.validate(s.end_time))
 }
 
 pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
@@ -284,6 +423,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 sim: None,
                 output: None,
                 output_every: 1,
+                checkpoint_every: 0,
                 host: h.clone(),
                 started: None,
                 node_log: Vec::new(),
@@ -344,9 +484,21 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         "settings",
         |s: &mut ScriptSim, spec: Map| -> ScriptResult<()> {
             let mut st = s.borrow_mut();
-            let mut every = st.output_every;
-            apply_settings(st.model_mut()?, &mut every, &spec)?;
-            st.output_every = every;
+            let mut knobs = Knobs {
+                output_every: st.output_every,
+                checkpoint_every: st.checkpoint_every,
+            };
+            if let Some(model) = st.model.as_mut() {
+                apply_settings(&mut model.settings, &mut knobs, &spec)?;
+            } else if let Some(sim) = st.sim.as_mut() {
+                // A running simulation (the REPL after a rollback, say) takes new settings
+                // for its next increments.
+                let mut settings = sim.model.settings.clone();
+                apply_settings(&mut settings, &mut knobs, &spec)?;
+                lift(sim.change_settings(settings))?;
+            }
+            st.output_every = knobs.output_every;
+            st.checkpoint_every = knobs.checkpoint_every;
             Ok(())
         },
     );
@@ -373,15 +525,14 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             }
             let mut st = s.borrow_mut();
             st.simulation()?;
-            let total = {
-                let sim = st.sim.as_ref().expect("started");
-                sim.model.settings.increments as u64
-            };
+            // Progress in pseudo-time (per mille): the number of adaptive increments is not
+            // known beforehand.
+            let end_time = st.sim.as_ref().expect("started").model.settings.end_time;
             let bar = h.progress.then(|| {
-                let b = indicatif::ProgressBar::new(total);
+                let b = indicatif::ProgressBar::new(1000);
                 b.set_style(
                     indicatif::ProgressStyle::with_template(
-                        "{bar:40} {pos}/{len} increments  {msg}  [{elapsed_precise}]",
+                        "{bar:40} {percent:>3}% of the time  {msg}  [{elapsed_precise}]",
                     )
                     .expect("valid template"),
                 );
@@ -400,10 +551,10 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                     }
                 };
                 if let Some(b) = &bar {
-                    b.inc(1);
+                    b.set_position((1000.0 * r.time / end_time).round() as u64);
                     b.set_message(format!(
-                        "t = {:.4}, {} Newton iterations",
-                        r.time, r.iterations
+                        "increment {}, t = {:.4}, dt = {:.3e}, {} Newton iterations",
+                        r.index, r.time, r.dt, r.iterations
                     ));
                 }
                 last = Some(r);
@@ -551,6 +702,33 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             })
             .unwrap_or_default()
     });
+    // Undo the last converged increment(s): the REPL can then change a setting and step on.
+    engine.register_fn("rollback", |s: &mut ScriptSim| -> ScriptResult<f64> {
+        rollback(s, 1)
+    });
+    engine.register_fn(
+        "rollback",
+        |s: &mut ScriptSim, n: i64| -> ScriptResult<f64> {
+            if n < 1 {
+                return runtime_error(format!("rollback({n}): the count must be >= 1"));
+            }
+            rollback(s, n as usize)
+        },
+    );
+    engine.register_fn(
+        "checkpoint",
+        |s: &mut ScriptSim, path: &str| -> ScriptResult<String> {
+            let mut st = s.borrow_mut();
+            st.simulation()?;
+            let SimState { sim, output, .. } = &mut *st;
+            match (output.as_ref(), sim.as_ref()) {
+                (Some(out), Some(sim)) => {
+                    Ok(lift(out.write_checkpoint(sim, path))?.display().to_string())
+                }
+                _ => runtime_error("output is off for this simulation (settings output_every = 0)"),
+            }
+        },
+    );
     engine.register_fn("write_frame", |s: &mut ScriptSim| -> ScriptResult<()> {
         let mut st = s.borrow_mut();
         st.simulation()?;
@@ -560,4 +738,35 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             _ => runtime_error("output is off for this simulation (settings output_every = 0)"),
         }
     });
+    let h = host.clone();
+    // A text file below the run's output folder (absolute paths and '..' are refused).
+    engine.register_fn(
+        "write_text",
+        move |path: &str, text: &str| -> ScriptResult<String> {
+            let folder = lift(crate::output::OutputFolder::create(&h.out_dir))?;
+            let file = lift(folder.resolve_for_write(path))?;
+            lift(std::fs::write(&file, text).map_err(|e| Error::io(&file, e)))?;
+            Ok(file.display().to_string())
+        },
+    );
+}
+
+fn rollback(s: &mut ScriptSim, n: usize) -> ScriptResult<f64> {
+    let mut st = s.borrow_mut();
+    let SimState {
+        sim,
+        output,
+        node_log,
+        ..
+    } = &mut *st;
+    let Some(sim) = sim.as_mut() else {
+        return runtime_error("nothing to roll back: the simulation has not started");
+    };
+    let t = lift(sim.rollback(n))?;
+    let kept = sim.history.len();
+    node_log.retain(|(index, _, _)| *index <= kept);
+    if let Some(out) = output.as_mut() {
+        lift(out.record(sim))?;
+    }
+    Ok(t)
 }

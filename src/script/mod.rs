@@ -6,6 +6,7 @@
 
 mod api_scene;
 mod api_sim;
+mod api_tools;
 mod convert;
 pub mod repl;
 mod stdlib;
@@ -31,6 +32,13 @@ pub struct HostOptions {
     pub defer_run: Rc<std::cell::Cell<bool>>,
     /// Script friction laws by tool name (`tool.friction(|work, slip, pressure| ...)`).
     pub script_laws: Rc<std::cell::RefCell<std::collections::BTreeMap<String, rhai::FnPtr>>>,
+    /// `tribo run --restart FILE`: the first simulation the script starts continues from
+    /// this checkpoint.
+    pub restart: Option<PathBuf>,
+    /// Set once the restart checkpoint has been loaded.
+    pub restart_used: Rc<std::cell::Cell<bool>>,
+    /// Print warnings of converged increments (status cycling, limits exceeded at dt_min).
+    pub warnings: bool,
 }
 
 impl Default for HostOptions {
@@ -41,6 +49,9 @@ impl Default for HostOptions {
             max_operations: 50_000_000,
             defer_run: Rc::new(std::cell::Cell::new(false)),
             script_laws: Rc::default(),
+            restart: None,
+            restart_used: Rc::default(),
+            warnings: true,
         }
     }
 }
@@ -57,6 +68,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.set_module_resolver(stdlib::resolver(script_dir));
     let host = Rc::new(host.clone());
     api_scene::register(&mut engine, host.clone());
+    api_tools::register(&mut engine, script_dir);
     api_sim::register(&mut engine, host);
     register_checks(&mut engine);
     engine

@@ -21,6 +21,9 @@ Rhai lines are evaluated in a persistent scope. Useful calls on a simulation `si
   sim.displacement(node)          a node's displacement
   sim.write_frame()               write a VTK frame now
   sim.history()                   one map per converged increment
+  sim.rollback()                  undo the last converged increment (sim.rollback(n): n of them)
+  sim.settings(#{...})            change stepping settings (step_control, dt_max, ...) and step on
+  sim.checkpoint(\"name.json\")     save the committed state below the output folder
 Commands: :help, :quit";
 
 /// Runs the REPL; returns when the person quits (Ctrl-D or :quit).

@@ -9,6 +9,7 @@ use std::path::Path;
 const MODULES: &[(&str, &str)] = &[
     ("testing", include_str!("../../std-lib/testing.rhai")),
     ("scenes", include_str!("../../std-lib/scenes.rhai")),
+    ("tools", include_str!("../../std-lib/tools.rhai")),
 ];
 
 /// Names of the embedded std-lib modules.

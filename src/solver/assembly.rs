@@ -135,6 +135,8 @@ pub struct IncrementContext<'a> {
     pub committed_contact: &'a [Vec<ContactNodeState>],
     pub frozen: Option<Vec<Vec<Option<FrozenFrame>>>>,
     pub is_fixed: &'a [bool],
+    /// Contact status imposed per (tool, candidate) by the anti-cycling treatment.
+    pub forced: Option<Vec<Vec<Option<crate::contact::ContactStatus>>>>,
 }
 
 impl IncrementContext<'_> {
@@ -222,6 +224,7 @@ impl IncrementContext<'_> {
                     committed.mu,
                     model.settings.contact.curvature,
                 );
+                params.forced = self.forced.as_ref().and_then(|f| f[c][k]);
                 if let (FrictionUpdate::Implicit, Some(law), Some(p), Some(_)) = (
                     model.settings.contact.friction_update,
                     contact.tool.friction.bernstein(),

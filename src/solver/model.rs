@@ -70,6 +70,8 @@ pub struct SolverSettings {
     /// F-bar volumetric treatment of the finite-strain hexahedron (default on; off gives
     /// the fully integrated element, which locks: for verification only).
     pub fbar: bool,
+    /// Increment control, line search, anti-cycling and rollback depth.
+    pub stepping: super::step_control::StepSettings,
 }
 
 impl Default for SolverSettings {
@@ -86,6 +88,7 @@ impl Default for SolverSettings {
             eliminate_multipliers: true,
             kinematics: crate::element::StrainTheory::Small,
             fbar: true,
+            stepping: Default::default(),
         }
     }
 }
@@ -183,12 +186,15 @@ impl Model {
         }
         let candidates = self.nodes(set)?;
         let areas = self.mesh.tributary_areas(&candidates)?;
-        // P-wave modulus times a length: the stiffness of a column of material under the node.
-        let stiffness = self.material.elastic_tangent()[(0, 0)];
-        let r = areas
-            .iter()
-            .map(|a| r.unwrap_or_else(|| stiffness * a.max(f64::MIN_POSITIVE).sqrt()))
-            .collect();
+        let r = match r {
+            Some(r) => vec![r; candidates.len()],
+            // The stiffness of the column of material under each node (see `augmentation`).
+            None => super::augmentation::default_r(
+                &self.mesh,
+                self.material.elastic_tangent()[(0, 0)],
+                &candidates,
+            )?,
+        };
         self.contacts.push(ToolContact {
             tool,
             candidates,

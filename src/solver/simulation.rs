@@ -4,20 +4,29 @@
 //! leaves the last converged state untouched.
 
 use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use super::checkpoint::SavedState;
 use super::condense::Condenser;
+use super::cycling::{CyclingMonitor, CyclingNode};
 use super::linear::{FaerLu, LinearSolver};
 use super::model::Model;
 use super::sparse::SparsePattern;
+use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
 use crate::element::{Element, Hex8};
 use crate::geometry::Vec3;
 use crate::material::PointState;
 use crate::{Error, Result};
+use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::Instant;
 
+/// Consecutive merit increases that count as divergence.
+const DIVERGENCE_ITERATIONS: usize = 3;
+/// Halvings of the line search (smallest step 1/16 of the Newton step).
+const LINE_SEARCH_CUTS: usize = 4;
+
 /// One Newton iteration's residual norms.
-#[derive(Clone, Copy, Debug, serde::Serialize)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct IterationRecord {
     /// Force residual (2-norm over free displacement dofs) divided by the reference force.
     pub force_rel: f64,
@@ -28,7 +37,7 @@ pub struct IterationRecord {
 }
 
 /// What one converged increment did.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct IncrementReport {
     pub index: usize,
     pub time: f64,
@@ -45,6 +54,48 @@ pub struct IncrementReport {
     pub slipping_nodes: usize,
     /// Energy balance after this increment.
     pub energy: EnergyBalance,
+    /// Adaptive stepping: converged trials rejected because an increment limit was exceeded.
+    pub rejected: usize,
+    /// Adaptive stepping: the largest plastic strain, rotation and slip increments.
+    pub measures: IncrementMeasures,
+    /// Adaptive stepping: what limited the next increment, and its size.
+    pub limit: Limit,
+    pub next_dt: f64,
+    /// Backtracking steps of the line search over the increment's iterations.
+    pub line_search_cuts: usize,
+    /// Nodes whose contact status cycled within the increment.
+    pub cycling: Vec<CyclingNode>,
+    /// Anything the user should know about this increment.
+    pub warnings: Vec<String>,
+}
+
+/// A converged Newton solve of one increment, not yet committed.
+struct Trial {
+    x: Vec<f64>,
+    eval: Evaluation,
+    iterations: usize,
+    residuals: Vec<IterationRecord>,
+    times: PhaseTimes,
+    cycling: Vec<CyclingNode>,
+    line_search_cuts: usize,
+    /// Residual of the free contact law at the converged state (differs from the last
+    /// residual only when some status was frozen).
+    unfrozen: IterationRecord,
+}
+
+/// Failures after which a smaller increment may succeed.
+fn retryable(err: &Error) -> bool {
+    matches!(err, Error::NoConvergence(_) | Error::LinearSolver(_))
+}
+
+/// An error's message without its kind prefix, for nesting in another message.
+fn bare(err: &Error) -> String {
+    match err {
+        Error::NoConvergence(m) | Error::LinearSolver(m) | Error::Input(m) | Error::Script(m) => {
+            m.clone()
+        }
+        other => other.to_string(),
+    }
 }
 
 /// Model plus its evolving, committed solution.
@@ -65,6 +116,11 @@ pub struct Simulation {
     pub phase_times: PhaseTimes,
     energy: EnergyBalance,
     energy_memory: EnergyMemory,
+    controller: StepController,
+    /// Schedule breakpoints and the end time: adaptive increments land on them.
+    stops: Vec<f64>,
+    /// Committed states before the last increments, for `rollback`.
+    saved: VecDeque<SavedState>,
 }
 
 impl Simulation {
@@ -122,7 +178,11 @@ impl Simulation {
         } else {
             None
         };
+        model.settings.stepping.validate(model.settings.end_time)?;
         Ok(Simulation {
+            controller: StepController::new(&model),
+            stops: schedule_stops(&model),
+            saved: VecDeque::new(),
             condenser,
             x: vec![0.0; dofs.n_dofs],
             dofs,
@@ -226,6 +286,7 @@ impl Simulation {
             committed_contact: &self.contact,
             frozen,
             is_fixed: &self.is_fixed,
+            forced: None,
         }
     }
 
@@ -263,7 +324,9 @@ impl Simulation {
         self.context(time, None).evaluate(x, &mut t)
     }
 
-    /// Advances one nominal increment (halving it on failure up to `max_cutbacks` times).
+    /// Advances one increment. Fixed stepping: one nominal increment, halved on failure up
+    /// to `max_cutbacks` times (the sub-increments are all in `history`). Adaptive stepping:
+    /// one increment of the size the controller chose (see `step_control`).
     pub fn step(&mut self) -> Result<IncrementReport> {
         if self.is_finished() {
             return Err(Error::Input(format!(
@@ -271,6 +334,13 @@ impl Simulation {
                 self.model.settings.end_time
             )));
         }
+        match self.model.settings.stepping.mode {
+            StepMode::Fixed => self.step_fixed(),
+            StepMode::Adaptive => self.step_adaptive(),
+        }
+    }
+
+    fn step_fixed(&mut self) -> Result<IncrementReport> {
         let target = (self.time + self.nominal_dt()).min(self.model.settings.end_time);
         let mut dt = target - self.time;
         let mut cutbacks = 0;
@@ -280,8 +350,9 @@ impl Simulation {
             } else {
                 self.time + dt
             };
-            match self.solve_increment(t_new) {
-                Ok(mut report) => {
+            match self.try_increment(t_new) {
+                Ok(trial) => {
+                    let mut report = self.accept(t_new, trial);
                     report.cutbacks = cutbacks;
                     self.history.push(report.clone());
                     if t_new < target {
@@ -290,22 +361,165 @@ impl Simulation {
                     }
                     return Ok(report);
                 }
-                Err(err @ (Error::NoConvergence(_) | Error::LinearSolver(_)))
-                    if cutbacks < self.model.settings.max_cutbacks =>
-                {
-                    let _ = err;
+                Err(err) if retryable(&err) && cutbacks < self.model.settings.max_cutbacks => {
                     cutbacks += 1;
                     dt *= 0.5;
                 }
                 Err(err) => {
                     return Err(Error::NoConvergence(format!(
-                        "increment {} from t = {} with dt = {dt} after {cutbacks} cutbacks: {err}",
+                        "increment {} from t = {} with dt = {dt} after {cutbacks} cutbacks: {}",
                         self.increments_done + 1,
-                        self.time
+                        self.time,
+                        bare(&err)
                     )))
                 }
             }
         }
+    }
+
+    fn step_adaptive(&mut self) -> Result<IncrementReport> {
+        let step = self.model.settings.stepping.clone();
+        let end = self.model.settings.end_time;
+        let dt_min = step.dt_min(end);
+        let mut dt = self.controller.dt.max(dt_min);
+        let (mut cutbacks, mut rejected) = (0, 0);
+        loop {
+            let t_new = StepController::next_time(self.time, dt, &self.stops);
+            let dt_used = t_new - self.time;
+            match self.try_increment(t_new) {
+                Ok(trial) => {
+                    let measures = self.measures(&trial);
+                    let verdict = self
+                        .controller
+                        .assess(&step, end, dt_used, &measures, trial.iterations);
+                    if !verdict.accept {
+                        rejected += 1;
+                        dt = verdict.next_dt;
+                        continue;
+                    }
+                    let mut report = self.accept(t_new, trial);
+                    report.cutbacks = cutbacks;
+                    report.rejected = rejected;
+                    report.measures = measures;
+                    report.limit = verdict.limit;
+                    let (ratio, which) = measures.ratio(&step);
+                    if ratio < 1.0 {
+                        report.warnings.push(format!(
+                            "{which:?} increment exceeds its limit by a factor {:.3} at the minimum step",
+                            1.0 / ratio
+                        ));
+                    }
+                    // No growth right after a cutback.
+                    let next = if cutbacks > 0 {
+                        verdict.next_dt.min(dt_used.max(dt_min))
+                    } else {
+                        verdict.next_dt
+                    };
+                    self.controller = StepController {
+                        dt: next,
+                        limit: verdict.limit,
+                    };
+                    report.next_dt = next;
+                    self.history.push(report.clone());
+                    return Ok(report);
+                }
+                Err(err) if retryable(&err) && dt_used > dt_min * (1.0 + 1e-9) => {
+                    cutbacks += 1;
+                    dt = (0.5 * dt_used).max(dt_min);
+                    self.controller.limit = Limit::Divergence;
+                }
+                Err(err) => {
+                    return Err(Error::NoConvergence(format!(
+                        "increment {} from t = {} cannot be completed at the minimum step dt = {dt_used:.6e} (dt_min = {dt_min:.6e}) after {cutbacks} cutbacks: {}",
+                        self.increments_done + 1,
+                        self.time,
+                        bare(&err)
+                    )))
+                }
+            }
+        }
+    }
+
+    /// Largest plastic strain, rotation and slip increments of a converged trial.
+    fn measures(&self, trial: &Trial) -> IncrementMeasures {
+        let mut m = IncrementMeasures::from_points(&self.points, &trial.eval.trial_points);
+        for (c, contact) in self.model.contacts.iter().enumerate() {
+            for (k, &node) in contact.candidates.iter().enumerate() {
+                let (res, _) = &trial.eval.nodal[c][k];
+                if res.status.is_active() {
+                    m.add_slip(node, res.slip_increment.norm());
+                }
+            }
+        }
+        m
+    }
+
+    /// Commits a converged trial (keeping the state it replaces for `rollback`).
+    fn accept(&mut self, t_new: f64, trial: Trial) -> IncrementReport {
+        let depth = self.model.settings.stepping.rollback_depth;
+        if depth > 0 {
+            if self.saved.len() >= depth {
+                self.saved.pop_front();
+            }
+            let state = self.saved_state();
+            self.saved.push_back(state);
+        }
+        self.phase_times.elements += trial.times.elements;
+        self.phase_times.contact += trial.times.contact;
+        self.phase_times.factorization_and_solve += trial.times.factorization_and_solve;
+        let mut report = self.commit(
+            t_new,
+            trial.x,
+            trial.eval,
+            trial.iterations,
+            trial.residuals,
+        );
+        report.line_search_cuts = trial.line_search_cuts;
+        if !trial.cycling.is_empty() {
+            let nodes: Vec<String> = trial
+                .cycling
+                .iter()
+                .map(|n| {
+                    format!(
+                        "{}:{} ({} flips{})",
+                        self.model.contacts[n.tool].tool.name,
+                        n.node,
+                        n.flips,
+                        n.frozen
+                            .as_ref()
+                            .map(|s| format!(", frozen {s}"))
+                            .unwrap_or_default()
+                    )
+                })
+                .collect();
+            report.warnings.push(format!(
+                "contact status cycled at {} node(s): {}; free-law residual at the converged state: force {:.3e} relative, contact {:.3e}",
+                nodes.len(),
+                nodes.join(", "),
+                trial.unfrozen.force_rel,
+                trial.unfrozen.contact
+            ));
+        }
+        report.cycling = trial.cycling;
+        report
+    }
+
+    /// Undoes the last `n` converged increments (at most as many as were kept: settings
+    /// `rollback_depth`). Returns the time reached.
+    pub fn rollback(&mut self, n: usize) -> Result<f64> {
+        if n == 0 || n > self.saved.len() {
+            return Err(Error::Input(format!(
+                "cannot roll back {n} increment(s): {} converged state(s) are kept (setting rollback_depth = {})",
+                self.saved.len(),
+                self.model.settings.stepping.rollback_depth
+            )));
+        }
+        let mut state = None;
+        for _ in 0..n {
+            state = self.saved.pop_back();
+        }
+        self.restore_state(state.expect("n >= 1 states popped"));
+        Ok(self.time)
     }
 
     /// Runs to the end time, calling `on_increment` after each converged increment.
@@ -320,37 +534,107 @@ impl Simulation {
         Ok(())
     }
 
-    fn solve_increment(&mut self, t_new: f64) -> Result<IncrementReport> {
+    /// Newton's method for the increment ending at `t_new`, nothing committed.
+    fn try_increment(&mut self, t_new: f64) -> Result<Trial> {
         // The factorization cache lives outside `self` while the context borrows it.
         let mut linear = std::mem::take(&mut self.linear);
         let outcome = self.newton(t_new, &mut linear);
         self.linear = linear;
-        let (x, eval, iterations, residuals, times) = outcome?;
-        self.phase_times.elements += times.elements;
-        self.phase_times.contact += times.contact;
-        self.phase_times.factorization_and_solve += times.factorization_and_solve;
-        Ok(self.commit(t_new, x, eval, iterations, residuals))
+        outcome
     }
 
-    #[allow(clippy::type_complexity)]
-    fn newton(
-        &self,
-        t_new: f64,
-        linear: &mut FaerLu,
-    ) -> Result<(
-        Vec<f64>,
-        Evaluation,
-        usize,
-        Vec<IterationRecord>,
-        PhaseTimes,
-    )> {
+    /// Residual norms of an evaluation (the convergence measures and the merit function).
+    fn residual_record(&self, eval: &Evaluation, weights: &[f64]) -> (IterationRecord, f64, f64) {
+        let settings = &self.model.settings;
+        let n_u = 3 * self.dofs.n_nodes;
+        let force = norm(&eval.residual[..n_u]);
+        let reference = norm(&eval.f_int)
+            .max(norm(&eval.f_ext))
+            .max(settings.force_abs_tol);
+        let contact = eval.residual[n_u..]
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        // Merit: the full residual with the contact rows (lengths) scaled by r (forces).
+        let merit = (force * force
+            + eval.residual[n_u..]
+                .iter()
+                .zip(weights)
+                .map(|(v, w)| (v * w).powi(2))
+                .sum::<f64>())
+        .sqrt();
+        (
+            IterationRecord {
+                force_rel: force / reference,
+                force,
+                contact,
+            },
+            merit,
+            reference,
+        )
+    }
+
+    /// Where the residual is largest: the three nodes with the largest force residual and
+    /// the contact pair with the largest constraint residual.
+    fn locate(&self, eval: &Evaluation) -> String {
+        let mut nodes: Vec<(usize, f64)> = (0..self.dofs.n_nodes)
+            .map(|n| (n, norm(&eval.residual[3 * n..3 * n + 3])))
+            .collect();
+        nodes.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let mut text = format!(
+            "largest force residual at node(s) {}",
+            nodes
+                .iter()
+                .take(3)
+                .map(|(n, r)| format!("{n} ({r:.3e})"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        let mut worst: Option<(usize, usize, f64)> = None;
+        for (c, contact) in self.model.contacts.iter().enumerate() {
+            if let Some(off) = self.dofs.lambda_offset[c] {
+                for (k, &node) in contact.candidates.iter().enumerate() {
+                    let r = norm(&eval.residual[off + 3 * k..off + 3 * k + 3]);
+                    if worst.is_none_or(|w| r > w.2) {
+                        worst = Some((c, node, r));
+                    }
+                }
+            }
+        }
+        if let Some((c, node, r)) = worst {
+            text += &format!(
+                "; largest contact residual at node {node} on tool '{}' ({r:.3e})",
+                self.model.contacts[c].tool.name
+            );
+        }
+        text
+    }
+
+    fn newton(&self, t_new: f64, linear: &mut FaerLu) -> Result<Trial> {
         let settings = self.model.settings.clone();
+        let step = &settings.stepping;
         let mut x = self.x.clone();
         let frozen = match settings.contact.frame {
             FrameUpdate::EveryIteration => None,
             FrameUpdate::Frozen => Some(self.frozen_frames(t_new)),
         };
-        let ctx = self.context(t_new, frozen);
+        let mut ctx = self.context(t_new, frozen);
+        let n_u = 3 * self.dofs.n_nodes;
+        let mut weights = vec![0.0; self.dofs.n_dofs - n_u];
+        for (c, contact) in self.model.contacts.iter().enumerate() {
+            if let Some(off) = self.dofs.lambda_offset[c] {
+                for (k, r) in contact.r.iter().enumerate() {
+                    weights[off - n_u + 3 * k..off - n_u + 3 * k + 3].fill(*r);
+                }
+            }
+        }
+        let sizes: Vec<usize> = self
+            .model
+            .contacts
+            .iter()
+            .map(|c| c.candidates.len())
+            .collect();
+        let mut monitor = CyclingMonitor::new(&sizes, step.anti_cycling, step.cycle_flips);
+        let node_of = |c: usize, k: usize| self.model.contacts[c].candidates[k];
         let mut times = PhaseTimes::default();
         self.dirichlet_predictor(&ctx, t_new, &mut x, linear, &mut times)?;
         for bc in &self.model.dirichlet {
@@ -360,57 +644,151 @@ impl Simulation {
             }
         }
         let mut residuals = Vec::new();
+        let mut merits: Vec<f64> = Vec::new();
         let mut iterations = 0;
-        let n_u = 3 * self.dofs.n_nodes;
-        let eval = loop {
-            let eval = ctx.evaluate(&x, &mut times)?;
-            let force = norm(&eval.residual[..n_u]);
-            let reference = norm(&eval.f_int)
-                .max(norm(&eval.f_ext))
-                .max(settings.force_abs_tol);
-            let contact = eval.residual[n_u..]
-                .iter()
-                .fold(0.0f64, |m, v| m.max(v.abs()));
-            let rec = IterationRecord {
-                force_rel: force / reference,
-                force,
-                contact,
-            };
+        let mut line_search_cuts = 0;
+        let mut eval = ctx.evaluate(&x, &mut times)?;
+        // Merits before a freeze belong to another problem: divergence is judged after it.
+        let mut window_start = 0;
+        loop {
+            if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
+                ctx.forced = monitor.forced();
+                eval = ctx.evaluate(&x, &mut times)?;
+                window_start = merits.len();
+            }
+            let (rec, merit, reference) = self.residual_record(&eval, &weights);
             residuals.push(rec);
-            if !(force.is_finite() && contact.is_finite()) {
+            merits.push(merit);
+            let cycling_note = || {
+                let r = monitor.report(node_of);
+                if r.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; status cycling at node(s) {:?}",
+                        r.iter().map(|n| n.node).collect::<Vec<_>>()
+                    )
+                }
+            };
+            if !(rec.force.is_finite() && rec.contact.is_finite()) {
                 return Err(Error::NoConvergence(format!(
                     "non-finite residual at iteration {iterations}"
                 )));
             }
-            let force_ok =
-                force <= settings.force_rel_tol * reference || force <= settings.force_abs_tol;
-            if force_ok && contact <= settings.contact_tol {
-                break eval;
+            let force_ok = rec.force <= settings.force_rel_tol * reference
+                || rec.force <= settings.force_abs_tol;
+            if force_ok && rec.contact <= settings.contact_tol {
+                break;
             }
             if iterations >= settings.max_iterations {
                 return Err(Error::NoConvergence(format!(
-                    "{iterations} Newton iterations without convergence (force residual {:.3e} relative, contact residual {:.3e})",
-                    rec.force_rel, contact
+                    "{iterations} Newton iterations without convergence (force residual {:.3e} relative, contact residual {:.3e}); {}{}",
+                    rec.force_rel,
+                    rec.contact,
+                    self.locate(&eval),
+                    cycling_note()
                 )));
             }
-            if iterations >= 4
-                && residuals.len() >= 2
-                && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30)
+            let grew = merits.len() > window_start + DIVERGENCE_ITERATIONS
+                && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
+                    .windows(2)
+                    .all(|w| w[1] > w[0])
+                && merit > merits[0];
+            if grew || (iterations >= 4 && rec.force_rel > 1e6 * residuals[0].force_rel.max(1e-30))
             {
                 return Err(Error::NoConvergence(format!(
-                    "Newton diverges (force residual grew to {:.3e} relative)",
-                    rec.force_rel
+                    "Newton diverges (force residual grew to {:.3e} relative); {}{}",
+                    rec.force_rel,
+                    self.locate(&eval),
+                    cycling_note()
                 )));
             }
             let ts = Instant::now();
-            let rhs = self.newton_step(&eval, linear)?;
+            let dx = self.newton_step(&eval, linear)?;
             times.factorization_and_solve += ts.elapsed().as_secs_f64();
-            for (xi, dx) in x.iter_mut().zip(&rhs) {
-                *xi += dx;
-            }
+            let (x_new, eval_new, cuts) = self.line_search(
+                &ctx,
+                &x,
+                &dx,
+                merit,
+                monitor.damping(),
+                &weights,
+                &mut times,
+            )?;
+            line_search_cuts += cuts;
+            x = x_new;
+            eval = eval_new;
             iterations += 1;
+        }
+        let unfrozen = if ctx.forced.is_some() {
+            ctx.forced = None;
+            let free = ctx.evaluate(&x, &mut times)?;
+            self.residual_record(&free, &weights).0
+        } else {
+            residuals[residuals.len() - 1]
         };
-        Ok((x, eval, iterations, residuals, times))
+        Ok(Trial {
+            x,
+            eval,
+            iterations,
+            residuals,
+            times,
+            cycling: monitor.report(node_of),
+            line_search_cuts,
+            unfrozen,
+        })
+    }
+
+    /// Backtracking (Armijo) line search on the merit function |R|: the step `alpha dx` with
+    /// the first alpha in `alpha0, alpha0/2, ...` (down to `alpha0/16`) that reduces the merit
+    /// by the factor `1 - 1e-4 alpha`; failing that, the trial with the smallest merit. A
+    /// trial that inverts an element counts as an infinite merit. With the line search off,
+    /// the step `alpha0 dx` is taken. Returns the new unknowns, their evaluation and the
+    /// number of backtracking steps.
+    #[allow(clippy::too_many_arguments)]
+    fn line_search(
+        &self,
+        ctx: &IncrementContext<'_>,
+        x: &[f64],
+        dx: &[f64],
+        merit0: f64,
+        alpha0: f64,
+        weights: &[f64],
+        times: &mut PhaseTimes,
+    ) -> Result<(Vec<f64>, Evaluation, usize)> {
+        let trial_x =
+            |alpha: f64| -> Vec<f64> { x.iter().zip(dx).map(|(xi, d)| xi + alpha * d).collect() };
+        if !self.model.settings.stepping.line_search {
+            let xn = trial_x(alpha0);
+            let e = ctx.evaluate(&xn, times)?;
+            return Ok((xn, e, 0));
+        }
+        let mut alpha = alpha0;
+        let mut best: Option<(f64, Vec<f64>, Evaluation)> = None;
+        let mut last_err = None;
+        for cut in 0..=LINE_SEARCH_CUTS {
+            let xn = trial_x(alpha);
+            match ctx.evaluate(&xn, times) {
+                Ok(e) => {
+                    let m = self.residual_record(&e, weights).1;
+                    if m.is_finite() && m <= (1.0 - 1e-4 * alpha) * merit0 {
+                        return Ok((xn, e, cut));
+                    }
+                    if m.is_finite() && best.as_ref().is_none_or(|b| m < b.0) {
+                        best = Some((m, xn, e));
+                    }
+                }
+                Err(err) => last_err = Some(err),
+            }
+            alpha *= 0.5;
+        }
+        match (best, last_err) {
+            (Some((_, xn, e)), _) => Ok((xn, e, LINE_SEARCH_CUTS)),
+            (None, Some(err)) => Err(err),
+            (None, None) => Err(Error::NoConvergence(
+                "non-finite residual at every line-search step".into(),
+            )),
+        }
     }
 
     /// Linearised Dirichlet predictor: when prescribed values change, the first update
@@ -562,6 +940,13 @@ impl Simulation {
             active_nodes: active,
             slipping_nodes: slipping,
             energy,
+            rejected: 0,
+            measures: IncrementMeasures::default(),
+            limit: Limit::None,
+            next_dt: dt,
+            line_search_cuts: 0,
+            cycling: Vec::new(),
+            warnings: Vec::new(),
         }
     }
 
@@ -625,6 +1010,71 @@ impl Simulation {
         e.clone()
     }
 
+    /// The committed state: what a checkpoint holds and `rollback` returns to.
+    pub fn saved_state(&self) -> SavedState {
+        SavedState {
+            x: self.x.clone(),
+            points: self.points.clone(),
+            contact: self.contact.clone(),
+            time: self.time,
+            increments_done: self.increments_done,
+            history_len: self.history.len(),
+            energy: self.energy.clone(),
+            energy_memory: self.energy_memory.clone(),
+            controller: self.controller,
+        }
+    }
+
+    /// Makes `state` the committed state (its shape must match this model: see
+    /// `checkpoint::Checkpoint::restore`, which checks it).
+    pub fn restore_state(&mut self, state: SavedState) {
+        self.x = state.x;
+        self.points = state.points;
+        self.contact = state.contact;
+        self.time = state.time;
+        self.increments_done = state.increments_done;
+        self.history.truncate(state.history_len);
+        self.energy = state.energy;
+        self.energy_memory = state.energy_memory;
+        self.controller = state.controller;
+    }
+
+    /// Replaces the settings of a running simulation (after a rollback in the REPL, say).
+    /// Settings that shape the unknowns (enforcement, multiplier elimination) cannot
+    /// change once the simulation has started.
+    pub fn change_settings(&mut self, settings: super::SolverSettings) -> Result<()> {
+        let old = &self.model.settings;
+        if settings.contact.enforcement != old.contact.enforcement
+            || settings.eliminate_multipliers != old.eliminate_multipliers
+            || settings.kinematics != old.kinematics
+            || settings.fbar != old.fbar
+        {
+            return Err(Error::Input(
+                "enforcement, eliminate_multipliers, kinematics and fbar cannot change once the simulation has started"
+                    .into(),
+            ));
+        }
+        settings.stepping.validate(settings.end_time)?;
+        let (lo, hi) = (
+            settings.stepping.dt_min(settings.end_time),
+            settings.stepping.dt_max(settings.end_time),
+        );
+        self.model.settings = settings;
+        self.stops = schedule_stops(&self.model);
+        self.controller.dt = self.controller.dt.clamp(lo, hi);
+        Ok(())
+    }
+
+    /// Forgets the states kept for `rollback` (after loading a checkpoint).
+    pub fn clear_rollback(&mut self) {
+        self.saved.clear();
+    }
+
+    /// Committed states kept for `rollback`.
+    pub fn rollback_available(&self) -> usize {
+        self.saved.len()
+    }
+
     /// The energy balance so far.
     pub fn energy(&self) -> &EnergyBalance {
         &self.energy
@@ -664,7 +1114,7 @@ impl Simulation {
 }
 
 /// Energy bookkeeping of a run, cumulative from t = 0.
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct EnergyBalance {
     /// Work done on the body by the tools' motion.
     pub tool_work: f64,
@@ -689,8 +1139,8 @@ pub struct EnergyBalance {
 }
 
 /// Forces at the end of the last increment, for the trapezoidal rule.
-#[derive(Clone, Debug, Default)]
-struct EnergyMemory {
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct EnergyMemory {
     support_forces: Vec<f64>,
     external_forces: Vec<f64>,
     tool_forces: Vec<Vec3>,

@@ -2,13 +2,20 @@
 
 use crate::geometry::{Mat3, Projection, RigidSurface, SurfaceHint, Vec3};
 
-/// Rigid placement of a surface: a global point is `x = R x_local + t`.
-///
-/// Only the translation `t` exists so far (`R = I`); the maps below are written so that a
-/// rotation can be added without changing their callers.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// Rigid placement of a surface: a global point is `x = R x_local + t`, `R` a rotation.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pose {
+    pub rotation: Mat3,
     pub translation: Vec3,
+}
+
+impl Default for Pose {
+    fn default() -> Pose {
+        Pose {
+            rotation: Mat3::identity(),
+            translation: Vec3::zeros(),
+        }
+    }
 }
 
 impl Pose {
@@ -18,33 +25,48 @@ impl Pose {
     }
 
     pub fn from_translation(translation: Vec3) -> Pose {
-        Pose { translation }
+        Pose {
+            translation,
+            ..Pose::default()
+        }
+    }
+
+    /// Rotation by `angle` (radians, right-handed) about the axis through `point` along
+    /// the unit vector `axis`, then translation by `translation`:
+    /// `x = R (p - point) + point + translation`.
+    pub fn about_axis(point: &Vec3, axis: &Vec3, angle: f64, translation: &Vec3) -> Pose {
+        let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(*axis), angle)
+            .into_inner();
+        Pose {
+            rotation: r,
+            translation: point - r * point + translation,
+        }
     }
 
     /// Global point to the surface's frame: `R^T (x - t)`.
     pub fn to_local(&self, x: &Vec3) -> Vec3 {
-        x - self.translation
+        self.rotation.tr_mul(&(x - self.translation))
     }
 
     /// Surface-frame point to global: `R p + t`.
     pub fn to_global_point(&self, p: &Vec3) -> Vec3 {
-        p + self.translation
+        self.rotation * p + self.translation
     }
 
     /// Surface-frame vector (normal, direction) to global: `R v`.
     pub fn to_global_vector(&self, v: &Vec3) -> Vec3 {
-        *v
+        self.rotation * v
     }
 
-    /// Global direction to the surface frame: `R^T v` (identity rotation for now).
+    /// Global direction to the surface frame: `R^T v`.
     pub fn to_local_vector(&self, v: &Vec3) -> Vec3 {
-        *v
+        self.rotation.tr_mul(v)
     }
 
     /// Surface-frame tensor to global: `R G R^T`. For the normal gradient this follows from
     /// `n(x) = R n_local(R^T (x - t))`.
     pub fn to_global_matrix(&self, g: &Mat3) -> Mat3 {
-        *g
+        self.rotation * g * self.rotation.transpose()
     }
 }
 
@@ -134,6 +156,35 @@ mod tests {
                 }
             }
             assert!(inside > 30 && outside > 30, "{}", surface.describe());
+        }
+    }
+
+    /// A rotated and translated surface: the posed projection is the rotated local one,
+    /// and its normal gradient matches finite differences.
+    #[test]
+    fn rotated_pose_maps_projection_and_gradient() {
+        let mut rng = Rng::new(43);
+        let pose = Pose::about_axis(
+            &Vec3::new(1.0, 2.0, -1.0),
+            &Vec3::new(0.3, -0.5, 1.0).normalize(),
+            0.7,
+            &Vec3::new(-2.0, 0.5, 1.0),
+        );
+        assert!((pose.rotation.transpose() * pose.rotation - Mat3::identity()).norm() < 1e-15);
+        for surface in surfaces() {
+            let project = |y: &Vec3| project_posed(surface.as_ref(), &pose, y, None);
+            for _ in 0..100 {
+                let x = rng.vec3(4.0);
+                let local = surface.project(&x, None).unwrap();
+                let xg = pose.to_global_point(&x);
+                let posed = project(&xg).unwrap();
+                assert_projection_consistent(&posed, &xg);
+                assert!((posed.foot - pose.to_global_point(&local.foot)).norm() < 1e-12);
+                assert!((posed.normal - pose.rotation * local.normal).norm() < 1e-12);
+                assert!((posed.gap - local.gap).abs() < 1e-12);
+                assert!((pose.to_local(&xg) - x).norm() < 1e-13);
+                assert_gradient_matches_fd(&project, &xg);
+            }
         }
     }
 

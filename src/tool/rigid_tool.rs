@@ -1,4 +1,4 @@
-//! A rigid tool: an analytic surface, where it is at each time, and its friction law.
+//! A rigid tool: a surface, where it is at each time, and its friction law.
 
 use super::pose::{project_posed, Pose};
 use super::schedule::Schedule;
@@ -27,9 +27,7 @@ impl Tool {
 
     /// The tool's pose at (pseudo-)time `t`.
     pub fn pose(&self, t: f64) -> Pose {
-        Pose {
-            translation: self.schedule.translation(t),
-        }
+        self.schedule.pose(t)
     }
 
     /// Closest-point projection of a global point on the tool at pose `pose`.

@@ -3,14 +3,27 @@
 
 use std::ops::{Add, Mul, Sub};
 
-use crate::geometry::{finite_vec3, Vec3};
+use super::Pose;
+use crate::geometry::{finite_vec3, unit_vec3, Vec3};
 use crate::{Error, Result};
 
-/// Tool translation against pseudo-time: linear between the points `(t_i, u_i)`, equal to
-/// the first value before `t_0` and to the last value after the last time.
+/// Tool motion against pseudo-time: a translation linear between the points `(t_i, u_i)`,
+/// equal to the first value before `t_0` and to the last value after the last time; and
+/// optionally a rotation about a fixed axis by an angle piecewise linear in time (same
+/// rules), applied before the translation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Schedule {
     points: Vec<(f64, Vec3)>,
+    rotation: Option<AxisRotation>,
+}
+
+/// Rotation of a tool about the axis through `point` along the unit vector `axis`, by the
+/// angle `angle(t)` (radians, right-handed about `axis`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisRotation {
+    pub point: Vec3,
+    pub axis: Vec3,
+    pub angle: ScalarSchedule,
 }
 
 impl Schedule {
@@ -21,13 +34,61 @@ impl Schedule {
         for (i, (_, u)) in points.iter().enumerate() {
             finite_vec3(&format!("schedule translation[{i}]"), u)?;
         }
-        Ok(Schedule { points })
+        Ok(Schedule {
+            points,
+            rotation: None,
+        })
     }
 
     /// A tool that never moves.
     pub fn fixed() -> Schedule {
         Schedule {
             points: vec![(0.0, Vec3::zeros())],
+            rotation: None,
+        }
+    }
+
+    /// The same translation, plus a rotation about the axis through `point` along `axis`
+    /// by the piecewise-linear angle `(t_i, angle_i)` in degrees. Errs on a zero or
+    /// non-finite axis or point, and on bad times or angles (naming the index).
+    pub fn with_rotation(
+        mut self,
+        point: Vec3,
+        axis: Vec3,
+        angles_deg: Vec<(f64, f64)>,
+    ) -> Result<Schedule> {
+        let point = finite_vec3("rotation axis point", &point)?;
+        let axis = unit_vec3("rotation axis", &axis)?;
+        let angle = ScalarSchedule::new(
+            angles_deg
+                .into_iter()
+                .map(|(t, a)| (t, a.to_radians()))
+                .collect(),
+        )
+        .map_err(|e| match e {
+            Error::Input(m) => Error::Input(format!("rotation {m}")),
+            other => other,
+        })?;
+        self.rotation = Some(AxisRotation { point, axis, angle });
+        Ok(self)
+    }
+
+    /// The same translation with `rotation` (validated when it was made).
+    pub fn keeping_rotation(mut self, rotation: Option<AxisRotation>) -> Schedule {
+        self.rotation = rotation;
+        self
+    }
+
+    pub fn rotation(&self) -> Option<&AxisRotation> {
+        self.rotation.as_ref()
+    }
+
+    /// The tool's placement at time `t`: `x = R(t) (p - a) + a + u(t)`.
+    pub fn pose(&self, t: f64) -> Pose {
+        let u = self.translation(t);
+        match &self.rotation {
+            None => Pose::from_translation(u),
+            Some(r) => Pose::about_axis(&r.point, &r.axis, r.angle.value(t), &u),
         }
     }
 
@@ -36,9 +97,10 @@ impl Schedule {
         interpolate(&self.points, t)
     }
 
-    /// Time of the last point.
+    /// Time of the last point (of translation or rotation).
     pub fn end_time(&self) -> f64 {
-        end_time(&self.points)
+        let rotation_end = self.rotation.as_ref().map_or(0.0, |r| r.angle.end_time());
+        end_time(&self.points).max(rotation_end)
     }
 
     pub fn points(&self) -> &[(f64, Vec3)] {
@@ -265,6 +327,45 @@ mod tests {
         let c = ScalarSchedule::constant(-3.5);
         assert_eq!(c.value(-1.0), -3.5);
         assert_eq!(c.value(7.0), -3.5);
+    }
+
+    #[test]
+    fn rotation_interpolates_the_angle_about_the_axis() {
+        let s = two_leg()
+            .with_rotation(
+                v(1.0, 0.0, 0.0),
+                v(0.0, 0.0, 2.0),
+                vec![(0.0, 0.0), (2.0, 90.0)],
+            )
+            .unwrap();
+        // At t = 2: translation (2, 0, -2), quarter turn about the vertical axis through x = 1.
+        let pose = s.pose(2.0);
+        let p = pose.to_global_point(&v(2.0, 0.0, 0.0));
+        assert!((p - v(1.0 + 2.0, 1.0, -2.0)).norm() < 1e-15);
+        let half = s.pose(1.0).to_global_vector(&v(1.0, 0.0, 0.0));
+        let c = std::f64::consts::FRAC_1_SQRT_2;
+        assert!((half - v(c, c, 0.0)).norm() < 1e-15);
+        assert_eq!(s.end_time(), 3.0);
+        let err = Schedule::fixed()
+            .with_rotation(v(0.0, 0.0, 0.0), v(0.0, 0.0, 0.0), vec![(0.0, 0.0)])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("rotation axis = (0, 0, 0) must be non-zero"),
+            "{err}"
+        );
+        let err = Schedule::fixed()
+            .with_rotation(
+                v(0.0, 0.0, 0.0),
+                v(0.0, 0.0, 1.0),
+                vec![(1.0, 0.0), (0.5, 3.0)],
+            )
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("rotation schedule time[1] = 0.5 must be greater than time[0] = 1"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -1,0 +1,449 @@
+//! Automatic increment control in the spirit of the R_min strategy (Yamada et al.; Menezes &
+//! Teodosiu): the size of the next increment is bounded by limits on what one increment may
+//! change, and by how hard Newton had to work.
+//!
+//! After an increment of size `dt` converged, the measured increments are compared with
+//! their limits:
+//!
+//! ```text
+//! R_p   = max_plastic_strain_increment / max over points  |Δε̄_p|
+//! R_rot = max_rotation_increment       / max over points  angle(polar(F_{n+1} F_n^-1))
+//! R_s   = max_slip_increment           / max over contact nodes |δ_t|
+//! R_it  = target_iterations / iterations
+//! R     = min(R_p, R_rot, R_s)
+//! ```
+//!
+//! If `R < 1` a limit is exceeded: the increment is rejected (nothing is committed) and
+//! retried from the last converged state with `dt * max(0.9 R, 1/4)`, unless `dt` is
+//! already the minimum, where it is accepted with the excess reported. Otherwise it is
+//! committed and the next increment is `dt * clamp(min(0.9 R, R_it), 1/2, growth)`, so
+//! steps grow again after easy convergence. A Newton failure (non-finite or growing
+//! residual, too many iterations, an inverted element, a failed linear solve) halves `dt`;
+//! below `dt_min` the run stops. The increments are adapted so that every breakpoint of a
+//! schedule (tools, prescribed displacements, loads) and the end time are hit exactly:
+//! a remaining interval shorter than two increments is split evenly, which avoids slivers.
+//!
+//! "fixed" stepping keeps `end_time / increments` with halving cutbacks on failure; it is
+//! the default, so the verification tests keep their exact increment sequences.
+
+use super::model::Model;
+use crate::material::PointState;
+use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// How the increment size is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StepMode {
+    /// `end_time / increments`, halved on failure (the default).
+    Fixed,
+    /// Bounded by increment limits and Newton effort, cut on failure (see the module doc).
+    Adaptive,
+}
+
+/// What to do when the contact status of some nodes cycles during one increment's Newton
+/// iterations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum AntiCycling {
+    /// Freeze the cycling nodes' status for the rest of the increment (the default).
+    Freeze,
+    /// Halve the Newton update while some node cycles.
+    Damp,
+    /// Detect and report only.
+    Off,
+}
+
+/// Settings of the increment control and of the Newton safeguards.
+#[derive(Clone, Debug)]
+pub struct StepSettings {
+    pub mode: StepMode,
+    /// Smallest increment (pseudo-time); `None`: end_time * 1e-6.
+    pub dt_min: Option<f64>,
+    /// Largest increment; `None`: no bound besides the end time.
+    pub dt_max: Option<f64>,
+    /// First increment in adaptive mode; `None`: end_time / increments.
+    pub dt_initial: Option<f64>,
+    pub max_plastic_strain_increment: f64,
+    /// Radians.
+    pub max_rotation_increment: f64,
+    /// Length units.
+    pub max_slip_increment: f64,
+    pub target_iterations: usize,
+    /// Largest growth factor of the increment after an easy one.
+    pub growth: f64,
+    /// Backtracking line search on the residual merit function.
+    pub line_search: bool,
+    pub anti_cycling: AntiCycling,
+    /// Status changes of one node within an increment that count as cycling.
+    pub cycle_flips: usize,
+    /// How many committed states are kept for `rollback`.
+    pub rollback_depth: usize,
+}
+
+impl Default for StepSettings {
+    fn default() -> Self {
+        StepSettings {
+            mode: StepMode::Fixed,
+            dt_min: None,
+            dt_max: None,
+            dt_initial: None,
+            max_plastic_strain_increment: 0.05,
+            max_rotation_increment: 0.1,
+            max_slip_increment: f64::INFINITY,
+            target_iterations: 6,
+            growth: 2.0,
+            line_search: true,
+            anti_cycling: AntiCycling::Freeze,
+            cycle_flips: 3,
+            rollback_depth: 3,
+        }
+    }
+}
+
+impl StepSettings {
+    pub fn dt_min(&self, end_time: f64) -> f64 {
+        self.dt_min.unwrap_or(end_time * 1e-6)
+    }
+
+    pub fn dt_max(&self, end_time: f64) -> f64 {
+        self.dt_max.unwrap_or(end_time)
+    }
+
+    /// Checks the values a script may set; the message names the setting.
+    pub fn validate(&self, end_time: f64) -> Result<()> {
+        let positive = [
+            ("dt_min", self.dt_min(end_time)),
+            ("dt_max", self.dt_max(end_time)),
+            ("dt_initial", self.dt_initial.unwrap_or(1.0)),
+            (
+                "max_plastic_strain_increment",
+                self.max_plastic_strain_increment,
+            ),
+            ("max_rotation_increment", self.max_rotation_increment),
+            ("max_slip_increment", self.max_slip_increment),
+            ("target_iterations", self.target_iterations as f64),
+        ];
+        for (what, v) in positive {
+            if v.is_nan() || v <= 0.0 {
+                return Err(Error::input(what, v, "must be > 0"));
+            }
+        }
+        if !(self.growth >= 1.0 && self.growth.is_finite()) {
+            return Err(Error::input("step_growth", self.growth, "must be >= 1"));
+        }
+        if self.dt_min(end_time) > self.dt_max(end_time) {
+            return Err(Error::Input(format!(
+                "dt_min = {} is larger than dt_max = {}",
+                self.dt_min(end_time),
+                self.dt_max(end_time)
+            )));
+        }
+        if self.cycle_flips < 2 {
+            return Err(Error::input(
+                "cycle_flips",
+                self.cycle_flips,
+                "must be >= 2 (a node must leave a status and come back)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Which criterion set the size of the next increment (a number in history.csv).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Limit {
+    #[default]
+    None,
+    PlasticStrain,
+    Rotation,
+    Slip,
+    Iterations,
+    MaxStep,
+    Divergence,
+}
+
+impl Limit {
+    /// 0 none, 1 plastic strain, 2 rotation, 3 slip, 4 iterations, 5 dt_max, 6 divergence.
+    pub fn code(self) -> f64 {
+        self as u8 as f64
+    }
+}
+
+/// Largest increments of one trial increment and where they occur.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+pub struct IncrementMeasures {
+    pub plastic_strain: f64,
+    /// Integration point (element * points per element + point) of the largest increment.
+    pub plastic_point: usize,
+    /// Radians.
+    pub rotation: f64,
+    pub rotation_point: usize,
+    pub slip: f64,
+    /// Mesh node of the largest slip.
+    pub slip_node: usize,
+}
+
+impl IncrementMeasures {
+    /// Equivalent plastic strain and rotation increments between committed and trial states.
+    pub fn from_points(committed: &[PointState], trial: &[PointState]) -> Self {
+        let mut m = IncrementMeasures::default();
+        for (i, (old, new)) in committed.iter().zip(trial).enumerate() {
+            let dp = (new.eq_plastic_strain - old.eq_plastic_strain).abs();
+            if dp > m.plastic_strain {
+                m.plastic_strain = dp;
+                m.plastic_point = i;
+            }
+            let angle = rotation_increment(&old.deformation_gradient, &new.deformation_gradient);
+            if angle > m.rotation {
+                m.rotation = angle;
+                m.rotation_point = i;
+            }
+        }
+        m
+    }
+
+    /// Adds a contact node's slip increment |δ_t|.
+    pub fn add_slip(&mut self, node: usize, slip: f64) {
+        if slip > self.slip {
+            self.slip = slip;
+            self.slip_node = node;
+        }
+    }
+
+    /// R = min over limits of limit / measured (infinite when nothing moved), and which
+    /// limit attains it.
+    pub fn ratio(&self, s: &StepSettings) -> (f64, Limit) {
+        let mut best = (f64::INFINITY, Limit::None);
+        for (limit, measured, which) in [
+            (
+                s.max_plastic_strain_increment,
+                self.plastic_strain,
+                Limit::PlasticStrain,
+            ),
+            (s.max_rotation_increment, self.rotation, Limit::Rotation),
+            (s.max_slip_increment, self.slip, Limit::Slip),
+        ] {
+            if measured > 0.0 && limit / measured < best.0 {
+                best = (limit / measured, which);
+            }
+        }
+        best
+    }
+}
+
+/// Rotation increment (radians) at an integration point: the polar rotation angle of
+/// f = F_new F_old^-1 where both gradients are well inside the physical range
+/// (det F >= 1/2), else the infinitesimal rotation |axial(skew(F_new - F_old))|, which
+/// equals it to first order and stays meaningful (linear in the increment) for the
+/// small-strain elements, whose F = I + grad u is not a true deformation gradient once
+/// grad u is large.
+pub fn rotation_increment(f_old: &crate::geometry::Mat3, f_new: &crate::geometry::Mat3) -> f64 {
+    if f_old.determinant() >= 0.5 && f_new.determinant() >= 0.5 {
+        incremental_rotation(f_old, f_new)
+    } else {
+        let d = f_new - f_old;
+        0.5 * crate::geometry::Vec3::new(
+            d[(2, 1)] - d[(1, 2)],
+            d[(0, 2)] - d[(2, 0)],
+            d[(1, 0)] - d[(0, 1)],
+        )
+        .norm()
+    }
+}
+
+/// Rotation angle (radians) of the polar decomposition of the incremental deformation
+/// gradient f = F_new F_old^-1: R = U V^T from f = U S V^T, angle = acos((tr R - 1) / 2).
+/// A singular F_old (not a deformation) gives 0.
+pub fn incremental_rotation(f_old: &crate::geometry::Mat3, f_new: &crate::geometry::Mat3) -> f64 {
+    let Some(inv) = f_old.try_inverse() else {
+        return 0.0;
+    };
+    let f = f_new * inv;
+    let svd = f.svd(true, true);
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return 0.0;
+    };
+    let mut r = u * v_t;
+    if r.determinant() < 0.0 {
+        // An inverted increment: the rotation is that of the proper part.
+        let mut u = u;
+        u.column_mut(2).neg_mut();
+        r = u * v_t;
+    }
+    ((r.trace() - 1.0) / 2.0).clamp(-1.0, 1.0).acos()
+}
+
+/// The controller's memory between increments (part of a checkpoint).
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct StepController {
+    /// Size of the next increment.
+    pub dt: f64,
+    /// What limited it.
+    pub limit: Limit,
+}
+
+/// Verdict on a converged trial increment.
+#[derive(Clone, Copy, Debug)]
+pub struct Assessment {
+    pub accept: bool,
+    /// Increment to try next (the retry if rejected).
+    pub next_dt: f64,
+    pub limit: Limit,
+}
+
+impl StepController {
+    pub fn new(model: &Model) -> Self {
+        let s = &model.settings;
+        let nominal = s.end_time / s.increments.max(1) as f64;
+        let dt = s.stepping.dt_initial.unwrap_or(nominal);
+        StepController {
+            dt: dt
+                .min(s.stepping.dt_max(s.end_time))
+                .max(s.stepping.dt_min(s.end_time)),
+            limit: Limit::None,
+        }
+    }
+
+    /// End of the next increment from `t` of (at most) size `dt`: lands exactly on the next
+    /// breakpoint in `stops` (sorted, last = end time), splitting a remainder shorter than
+    /// two increments evenly.
+    pub fn next_time(t: f64, dt: f64, stops: &[f64]) -> f64 {
+        let scale = stops.last().copied().unwrap_or(1.0).abs().max(1e-300);
+        let stop = stops
+            .iter()
+            .copied()
+            .find(|&s| s > t + 1e-12 * scale)
+            .unwrap_or(t + dt);
+        let remaining = stop - t;
+        if remaining <= dt * (1.0 + 1e-9) {
+            stop
+        } else if remaining < 2.0 * dt {
+            t + 0.5 * remaining
+        } else {
+            t + dt
+        }
+    }
+
+    /// Judges a converged trial of size `dt` that needed `iterations` Newton iterations.
+    pub fn assess(
+        &self,
+        settings: &StepSettings,
+        end_time: f64,
+        dt: f64,
+        measures: &IncrementMeasures,
+        iterations: usize,
+    ) -> Assessment {
+        let dt_min = settings.dt_min(end_time);
+        let dt_max = settings.dt_max(end_time);
+        let (r, limit) = measures.ratio(settings);
+        if r < 1.0 && dt > dt_min * (1.0 + 1e-9) {
+            return Assessment {
+                accept: false,
+                next_dt: (dt * (0.9 * r).max(0.25)).max(dt_min),
+                limit,
+            };
+        }
+        let r_it = settings.target_iterations as f64 / iterations.max(1) as f64;
+        let (mut factor, mut which) = if 0.9 * r < r_it {
+            (0.9 * r, limit)
+        } else {
+            (r_it, Limit::Iterations)
+        };
+        if factor > settings.growth {
+            factor = settings.growth;
+            which = Limit::Iterations;
+        }
+        factor = factor.max(0.5);
+        let mut next = dt * factor;
+        if next >= dt_max {
+            next = dt_max;
+            which = Limit::MaxStep;
+        }
+        Assessment {
+            accept: true,
+            next_dt: next.max(dt_min),
+            limit: which,
+        }
+    }
+}
+
+/// Every breakpoint of the model's schedules in (0, end_time], sorted, ending with the end
+/// time: increments land exactly on them.
+pub fn schedule_stops(model: &Model) -> Vec<f64> {
+    let end = model.settings.end_time;
+    let mut stops: Vec<f64> = Vec::new();
+    for c in &model.contacts {
+        stops.extend(c.tool.schedule.points().iter().map(|p| p.0));
+        if let Some(r) = c.tool.schedule.rotation() {
+            stops.extend(r.angle.points().iter().map(|p| p.0));
+        }
+    }
+    for d in &model.dirichlet {
+        stops.extend(d.value.points().iter().map(|p| p.0));
+    }
+    for l in &model.loads {
+        stops.extend(l.scale.points().iter().map(|p| p.0));
+    }
+    stops.retain(|&t| t > 0.0 && t < end);
+    stops.push(end);
+    stops.sort_by(f64::total_cmp);
+    stops.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * end);
+    stops
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Mat3, Vec3};
+
+    #[test]
+    fn polar_rotation_angle_of_rotation_times_stretch() {
+        // f = R(0.3 about an oblique axis) * symmetric stretch: the polar angle is 0.3.
+        let axis = Vec3::new(1.0, 2.0, -0.5).normalize();
+        let rot = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), 0.3);
+        let stretch = Mat3::new(1.1, 0.05, 0.0, 0.05, 0.95, 0.02, 0.0, 0.02, 1.03);
+        let f_old = Mat3::new(1.0, 0.1, 0.0, 0.0, 1.0, 0.0, 0.2, 0.0, 1.0);
+        let f_new = rot.matrix() * stretch * f_old;
+        let angle = incremental_rotation(&f_old, &f_new);
+        // Round-off of an SVD of a well-conditioned 3x3 matrix.
+        assert!((angle - 0.3).abs() < 1e-12, "{angle}");
+        assert!(incremental_rotation(&f_old, &(stretch * f_old)) < 1e-12);
+    }
+
+    #[test]
+    fn landing_on_breakpoints_without_slivers() {
+        let stops = [1.0, 3.0];
+        assert_eq!(StepController::next_time(0.0, 0.4, &stops), 0.4);
+        // 0.8 -> 1.0 is shorter than one increment: land.
+        assert_eq!(StepController::next_time(0.8, 0.4, &stops), 1.0);
+        // 0.5 -> 1.0 is 1.25 increments: split evenly.
+        assert_eq!(StepController::next_time(0.5, 0.4, &stops), 0.75);
+        assert_eq!(StepController::next_time(1.0, 5.0, &stops), 3.0);
+    }
+
+    #[test]
+    fn limits_reject_and_easy_steps_grow() {
+        let s = StepSettings {
+            max_slip_increment: 0.1,
+            ..StepSettings::default()
+        };
+        let ctl = StepController {
+            dt: 0.2,
+            limit: Limit::None,
+        };
+        let mut m = IncrementMeasures::default();
+        m.add_slip(7, 0.4);
+        let a = ctl.assess(&s, 3.0, 0.2, &m, 3);
+        assert!(!a.accept);
+        assert_eq!(a.limit, Limit::Slip);
+        // 0.9 * 0.25 < 1/4 -> the floor 1/4.
+        assert!((a.next_dt - 0.05).abs() < 1e-15);
+        let mut easy = IncrementMeasures::default();
+        easy.add_slip(7, 0.01);
+        let a = ctl.assess(&s, 3.0, 0.2, &easy, 2);
+        assert!(a.accept);
+        assert!((a.next_dt - 0.4).abs() < 1e-15, "growth capped at 2");
+        // At dt_min an excess is accepted (and reported by the caller).
+        let a = ctl.assess(&s, 3.0, 3e-6, &m, 3);
+        assert!(a.accept);
+    }
+}

@@ -1,0 +1,466 @@
+//! Robust stepping (issue 6): checkpoint/restart reproduces the uninterrupted run, rollback
+//! returns to a converged state, scripts cannot write outside their output folder and hit
+//! clear limits.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use tribo::output::read_vtu_point_field;
+use tribo::script::{self, HostOptions};
+use tribo::solver::checkpoint::Checkpoint;
+use tribo::solver::{Simulation, StepMode};
+
+fn out_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tribo-robust-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// Output to `dir`, warnings not printed.
+fn quiet_host(dir: &Path) -> HostOptions {
+    HostOptions {
+        out_dir: dir.to_path_buf(),
+        warnings: false,
+        ..HostOptions::default()
+    }
+}
+
+fn robust_script(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/robust")
+        .join(name)
+}
+
+fn adaptive_drag() -> tribo::solver::Model {
+    let mut model = common::cylinder_drag_model(8.0, 2.0, 16, 3.0);
+    model.settings.stepping.mode = StepMode::Adaptive;
+    model.settings.stepping.max_slip_increment = 0.5;
+    model.settings.increments = 4;
+    model
+}
+
+fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The checkpoint's JSON holds every f64 exactly, and the restarted run repeats the
+/// uninterrupted one: same increments, same final displacements (the bound 1e-12 is the
+/// issue's; the run being deterministic, the difference is expected to be exactly 0).
+#[test]
+fn restart_from_a_checkpoint_reproduces_the_uninterrupted_run() {
+    let mut full = Simulation::new(adaptive_drag()).unwrap();
+    full.run(|_, _| Ok(())).unwrap();
+    let n_full = full.history.len();
+    assert!(
+        n_full >= 6,
+        "adaptive drag takes several increments, got {n_full}"
+    );
+
+    let mut first = Simulation::new(adaptive_drag()).unwrap();
+    for _ in 0..n_full / 2 {
+        first.step().unwrap();
+    }
+    let json = Checkpoint::of(&first, vec![]).to_json().unwrap();
+    drop(first);
+
+    let mut resumed = Simulation::new(adaptive_drag()).unwrap();
+    Checkpoint::from_json(&json, "memory")
+        .unwrap()
+        .restore(&mut resumed)
+        .unwrap();
+    // Exact round trip of the state through JSON.
+    let again = Checkpoint::of(&resumed, vec![]).to_json().unwrap();
+    assert_eq!(json, again, "the restored state writes the same checkpoint");
+    resumed.run(|_, _| Ok(())).unwrap();
+
+    let diff = max_difference(full.displacements(), resumed.displacements());
+    println!(
+        "increments {n_full} (restart after {}), max |u_full - u_restarted| = {diff:e}",
+        n_full / 2
+    );
+    assert!(diff <= 1e-12, "restart differs by {diff}");
+    assert_eq!(resumed.history.len(), n_full);
+    let e_full = full.energy().frictional_dissipation[0];
+    let e_rest = resumed.energy().frictional_dissipation[0];
+    assert!((e_full - e_rest).abs() <= 1e-12 * e_full.abs().max(1.0));
+
+    // A checkpoint of another model is refused with a message naming the difference.
+    let refused = |model| {
+        let mut sim = Simulation::new(model).unwrap();
+        let ck = Checkpoint::from_json(&json, "memory").unwrap();
+        ck.restore(&mut sim).unwrap_err().to_string()
+    };
+    let err = refused(common::cylinder_drag_model(8.0, 2.0, 8, 3.0));
+    assert!(err.contains("does not belong to this model"), "{err}");
+    // Same mesh, another tool path: the tool is elsewhere at the checkpoint's time.
+    let mut moved = adaptive_drag();
+    moved.contacts[0].tool.schedule = tribo::tool::schedule::Schedule::new(vec![
+        (0.0, tribo::geometry::Vec3::zeros()),
+        (3.0, tribo::geometry::Vec3::new(0.0, 0.0, -0.12)),
+    ])
+    .unwrap();
+    let err = refused(moved);
+    assert!(err.contains("the schedules changed"), "{err}");
+    let err = Checkpoint::from_json("{\"x\": 1}", "bad.json")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("bad.json is not a tribo checkpoint"), "{err}");
+}
+
+fn last_frame(dir: &Path) -> PathBuf {
+    let mut frames: Vec<PathBuf> = std::fs::read_dir(dir.join("frames"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    frames.sort();
+    frames.pop().unwrap()
+}
+
+/// The same through the command-line path: the script writes checkpoints every two
+/// increments; `--restart` re-runs the script, loads one and continues to the end.
+#[test]
+fn scripted_restart_continues_from_a_written_checkpoint() {
+    let script = robust_script("restart_drag.rhai");
+    let full_dir = out_dir("restart-full");
+    let host = quiet_host(&full_dir);
+    script::run_file(&script, &[], &host).unwrap();
+    let checkpoint = full_dir.join("checkpoints/checkpoint_0002.json");
+    assert!(checkpoint.is_file(), "checkpoint written");
+
+    let rest_dir = out_dir("restart-rest");
+    let host = HostOptions {
+        restart: Some(checkpoint),
+        ..quiet_host(&rest_dir)
+    };
+    script::run_file(&script, &[], &host).unwrap();
+    let u_full = read_vtu_point_field(&last_frame(&full_dir), "displacement").unwrap();
+    let u_rest = read_vtu_point_field(&last_frame(&rest_dir), "displacement").unwrap();
+    let diff = max_difference(&u_full, &u_rest);
+    println!("scripted restart: max |u_full - u_restarted| = {diff:e}");
+    assert!(diff <= 1e-12, "restart differs by {diff}");
+    // history.csv of the restarted run holds every increment, the restored ones included.
+    let rows = |d: &Path| {
+        std::fs::read_to_string(d.join("history.csv"))
+            .unwrap()
+            .lines()
+            .count()
+    };
+    assert_eq!(rows(&full_dir), rows(&rest_dir));
+    let _ = std::fs::remove_dir_all(&full_dir);
+    let _ = std::fs::remove_dir_all(&rest_dir);
+}
+
+#[test]
+fn rollback_returns_to_the_previous_converged_state() {
+    let mut sim = Simulation::new(adaptive_drag()).unwrap();
+    sim.step().unwrap();
+    sim.step().unwrap();
+    let u2 = sim.displacements().to_vec();
+    let t2 = sim.time();
+    sim.step().unwrap();
+    assert!(max_difference(&u2, sim.displacements()) > 0.0);
+    let t = sim.rollback(1).unwrap();
+    assert_eq!(t, t2);
+    assert_eq!(max_difference(&u2, sim.displacements()), 0.0);
+    assert_eq!(sim.history.len(), 2);
+    // Stepping on repeats the increment exactly.
+    let r = sim.step().unwrap();
+    assert_eq!(r.index, 3);
+    let err = sim.rollback(10).unwrap_err().to_string();
+    assert!(err.contains("rollback_depth"), "{err}");
+}
+
+fn run_inline(name: &str, source: &str) -> Result<PathBuf, String> {
+    let dir = out_dir(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{name}.rhai"));
+    std::fs::write(&path, source).unwrap();
+    let out = dir.join("out");
+    let host = HostOptions {
+        out_dir: out.clone(),
+        ..HostOptions::default()
+    };
+    script::run_file(&path, &[], &host)
+        .map(|_| out)
+        .map_err(|e| e.to_string())
+}
+
+#[test]
+fn scripts_cannot_write_outside_their_output_folder() {
+    let err = run_inline("abs", "write_text(\"/tmp/x\", \"hello\");").unwrap_err();
+    assert!(
+        err.contains("\"/tmp/x\"") && err.contains("absolute paths are refused"),
+        "{err}"
+    );
+    let err = run_inline("dotdot", "write_text(\"../x\", \"hello\");").unwrap_err();
+    assert!(err.contains("\"../x\"") && err.contains("'..'"), "{err}");
+    let err = run_inline("nested", "write_text(\"notes/../../x\", \"hello\");").unwrap_err();
+    assert!(err.contains("'..'"), "{err}");
+    // Checkpoints go through the same guard.
+    let scene =
+        "let sim = simulation(block([0,0,0],[1,1,1],[1,1,1]), linear_elastic(1000.0, 0.3));\n\
+                 sim.fix(\"z-\", \"xyz\");\n";
+    let err = run_inline("ck", &format!("{scene}sim.checkpoint(\"/tmp/x\");")).unwrap_err();
+    assert!(err.contains("absolute paths are refused"), "{err}");
+    let err = run_inline("ck2", &format!("{scene}sim.checkpoint(\"../x\");")).unwrap_err();
+    assert!(err.contains("'..'"), "{err}");
+    // A relative path lands below the output folder.
+    let out = run_inline("ok", "write_text(\"notes/a.txt\", \"hello\");").unwrap();
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes/a.txt")).unwrap(),
+        "hello"
+    );
+    assert!(!Path::new("/tmp/x").exists() || std::fs::read_to_string("/tmp/x").unwrap() != "hello");
+}
+
+#[test]
+fn script_size_and_depth_limits_stop_with_a_clear_message() {
+    let err = run_inline("string", "let s = \"x\"; loop { s += s; }").unwrap_err();
+    assert!(err.to_lowercase().contains("length of string"), "{err}");
+    let err = run_inline("array", "let a = [1]; loop { a += a; }").unwrap_err();
+    assert!(err.to_lowercase().contains("size of array"), "{err}");
+    let err = run_inline("depth", "fn f(n) { f(n + 1) }\nf(0);").unwrap_err();
+    assert!(
+        err.to_lowercase().contains("stack overflow") || err.contains("call"),
+        "{err}"
+    );
+}
+
+/// Column `name` of a history.csv.
+fn history_column(dir: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == name).unwrap();
+    lines
+        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// A pin of radius 0.25 (half a cell) ploughs 6 mm through a plastic block with mu = 0.3.
+/// With two fixed increments (press, then the whole drag) Newton does not converge within
+/// the 10-iteration budget; adaptive steps with the same Newton settings complete, cutting
+/// the increments where Newton struggles, and history.csv records the cutbacks.
+#[test]
+fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
+    let script = robust_script("fast_drag.rhai");
+    let common_sets = [
+        "radius=0.25",
+        "cells=24",
+        "max_iterations=10",
+        "max_cutbacks=0",
+    ];
+    let sets = |mode: &str| {
+        let mut v: Vec<_> = common_sets
+            .iter()
+            .map(|s| script::parse_override(s).unwrap())
+            .collect();
+        v.push(script::parse_override(&format!("step_control={mode}")).unwrap());
+        v
+    };
+    let fixed_dir = out_dir("fast-fixed");
+    let host = quiet_host(&fixed_dir);
+    let err = script::run_file(&script, &sets("fixed"), &host)
+        .unwrap_err()
+        .to_string();
+    println!("fixed steps: {err}");
+    assert!(
+        err.contains("Newton iterations without convergence"),
+        "{err}"
+    );
+    assert!(
+        err.contains("largest force residual at node(s)"),
+        "names the nodes: {err}"
+    );
+    // The stop keeps what was written and saves the last converged state.
+    assert!(fixed_dir.join("checkpoints/final.json").is_file());
+    assert!(fixed_dir.join("frames/frame_0001.vtu").is_file());
+    let summary = std::fs::read_to_string(fixed_dir.join("summary.json")).unwrap();
+    assert!(summary.contains("\"stopped\""), "{summary}");
+
+    let adaptive_dir = out_dir("fast-adaptive");
+    let host = quiet_host(&adaptive_dir);
+    script::run_file(&script, &sets("adaptive"), &host).unwrap();
+    let time = history_column(&adaptive_dir, "time");
+    let cutbacks = history_column(&adaptive_dir, "cutbacks");
+    let total: f64 = cutbacks.iter().sum();
+    println!(
+        "adaptive steps: {} increments, {total} cutbacks, smallest dt {:e}",
+        time.len(),
+        history_column(&adaptive_dir, "dt")
+            .iter()
+            .cloned()
+            .fold(f64::INFINITY, f64::min)
+    );
+    assert_eq!(*time.last().unwrap(), 2.0, "lands exactly on the end time");
+    assert!(
+        time.contains(&1.0),
+        "lands exactly on the schedule's breakpoint t = 1"
+    );
+    assert!(total >= 1.0, "cutbacks recorded in history.csv");
+    let _ = std::fs::remove_dir_all(&fixed_dir);
+    let _ = std::fs::remove_dir_all(&adaptive_dir);
+}
+
+/// High friction (mu = 0.5), oblique drag of a small ball, full Newton steps: a node at the
+/// edge of the contact cycles between stick and slip. Without the treatment Newton
+/// diverges; freezing the node's status converges in a few iterations, the node is named in
+/// the report and history.csv, and the state reached also satisfies the free law to the
+/// Newton tolerances (the residual of the unfrozen operator there is printed).
+#[test]
+fn anti_cycling_makes_a_high_friction_drag_converge() {
+    let script = robust_script("high_friction_drag.rhai");
+    let run_with = |mode: &str, line_search: bool| {
+        let dir = out_dir(&format!("cycling-{mode}-{line_search}"));
+        let host = HostOptions {
+            out_dir: dir.clone(),
+            ..HostOptions::default()
+        };
+        let sets = [
+            script::parse_override(&format!("anti_cycling={mode}")).unwrap(),
+            script::parse_override(&format!("line_search={line_search}")).unwrap(),
+        ];
+        (script::run_file(&script, &sets, &host), dir)
+    };
+    let run = |mode: &str| run_with(mode, false);
+    let (off, off_dir) = run("off");
+    let err = off.unwrap_err().to_string();
+    println!("without anti-cycling: {err}");
+    assert!(err.contains("status cycling at node(s)"), "{err}");
+    let (on, on_dir) = run("freeze");
+    on.unwrap();
+    let iterations = history_column(&on_dir, "newton_iterations");
+    let cycling = history_column(&on_dir, "cycling_nodes");
+    let frozen = history_column(&on_dir, "frozen_nodes");
+    println!("with anti-cycling: Newton iterations per increment {iterations:?}, cycling nodes {cycling:?}, frozen {frozen:?}");
+    assert_eq!(iterations.len(), 4);
+    assert!(frozen.iter().sum::<f64>() >= 1.0, "a node was frozen");
+    assert!(
+        iterations.iter().all(|&i| i <= 12.0),
+        "converges in a few iterations: {iterations:?}"
+    );
+    // The line search alone also gets through: it backtracks the cycling full steps.
+    let (searched, searched_dir) = run_with("off", true);
+    searched.unwrap();
+    println!(
+        "line search, no anti-cycling: iterations {:?}, backtracks {:?}",
+        history_column(&searched_dir, "newton_iterations"),
+        history_column(&searched_dir, "line_search_cuts")
+    );
+    let _ = std::fs::remove_dir_all(&off_dir);
+    let _ = std::fs::remove_dir_all(&on_dir);
+    let _ = std::fs::remove_dir_all(&searched_dir);
+}
+
+/// The REPL steps, rolls back to the previous converged increment, switches to adaptive
+/// steps and steps on; history.csv follows the rollback.
+#[test]
+fn repl_rolls_back_and_changes_a_setting_before_stepping_on() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scripts/cylinder_drag.rhai");
+    let out = out_dir("repl-rollback");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .arg("repl")
+        .arg(&script)
+        .arg("--out")
+        .arg(&out)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(
+            b"sim.step(); sim.step(); sim.step();\n\
+              sim.rollback()\n\
+              sim.history().len()\n\
+              sim.settings(#{ step_control: \"adaptive\", dt_max: 0.05 });\n\
+              sim.step(); sim.time\n\
+              sim.rollback(9)\n\
+              :quit\n",
+        )
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    println!("{stdout}");
+    // Three nominal increments of 0.1, back to 0.2, then one adaptive step of 0.05.
+    assert!(lines.iter().any(|l| l.trim() == "0.2"), "{stdout}");
+    assert!(lines.iter().any(|l| l.trim() == "2"), "{stdout}");
+    assert!(
+        lines.iter().any(|l| l.trim().starts_with("0.25")),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("cannot roll back 9 increment(s)"),
+        "{stdout}"
+    );
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert_eq!(
+        history.lines().count(),
+        1 + 3,
+        "header + 2 kept + 1 new row"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
+    use std::process::Command;
+    let script = robust_script("restart_drag.rhai");
+    let dir = out_dir("bad-restart");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |ck: &Path| {
+        let out = Command::new(env!("CARGO_BIN_EXE_tribo"))
+            .args(["run", "--quiet", "--restart"])
+            .arg(ck)
+            .arg("--out")
+            .arg(dir.join("out"))
+            .arg(&script)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(
+            !out.status.success() && !stderr.contains("panicked"),
+            "{stderr}"
+        );
+        stderr
+    };
+    let err = run(&dir.join("missing.json"));
+    assert!(err.contains("missing.json"), "{err}");
+    let foreign = dir.join("foreign.json");
+    std::fs::write(&foreign, "{\"format\": \"something else\"}").unwrap();
+    let err = run(&foreign);
+    assert!(err.contains("is not a tribo checkpoint"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// When the increment cannot be completed at the minimum step the run stops with the
+/// reason and the nodes where the residual is largest; the committed state is untouched.
+#[test]
+fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
+    let mut model = adaptive_drag();
+    // One Newton iteration cannot converge a contact increment; dt cannot be cut below 0.4.
+    model.settings.max_iterations = 1;
+    model.settings.stepping.dt_min = Some(0.4);
+    let mut sim = Simulation::new(model).unwrap();
+    let err = sim.step().unwrap_err().to_string();
+    println!("{err}");
+    assert!(
+        err.contains("cannot be completed at the minimum step") && err.contains("dt_min = 4"),
+        "{err}"
+    );
+    assert!(err.contains("largest force residual at node(s)"), "{err}");
+    assert_eq!(sim.time(), 0.0);
+    assert!(sim.displacements().iter().all(|&u| u == 0.0));
+    assert!(sim.history.is_empty());
+}
