@@ -115,6 +115,32 @@ fn uniaxial_tension_to_50_percent_follows_the_swift_curve() {
     assert!(worst_ep < 1e-6, "plastic strain error {worst_ep:e}");
     // The plastic work of a proportional path is ∫ τ dεp along the Swift curve.
     assert!(e.plastic_dissipation > 0.9 * e.support_work);
+
+    // Output: the thickness (z) of the sheet columns and its log strain, and the
+    // equivalent plastic strain, as VTK fields.
+    let frame = tribo::output::run::frame(&sim);
+    let field = |name: &str, cells: bool| {
+        let list = if cells {
+            &frame.cell_data
+        } else {
+            &frame.point_data
+        };
+        list.iter()
+            .find(|f| f.name == name)
+            .unwrap_or_else(|| panic!("field {name}"))
+            .values
+            .clone()
+    };
+    let uz = sim.displacement(7).z;
+    for (t, et) in field("thickness", false)
+        .iter()
+        .zip(field("thickness_strain", false))
+    {
+        assert!((t - (1.0 + uz)).abs() < 1e-14 && (et - (1.0 + uz).ln()).abs() < 1e-14);
+    }
+    assert!(uz < -0.1, "the sheet thins");
+    let ep = exact_uniaxial(0.5).1;
+    assert!((field("equivalent_plastic_strain", true)[0] - ep).abs() < 1e-9 * ep);
 }
 
 /// Uniaxial Cauchy stress along x at a material point driven by a symmetric stretch `U`
@@ -260,11 +286,14 @@ fn rigid_rotation_of_a_plastic_element_is_objective() {
 /// Observed orders are taken over consecutive relative residuals inside (1e-10, 1e-2]:
 /// below 1e-10 round-off (~1e-12 here) dominates, and above 1e-2 Newton is not yet in its
 /// asymptotic range (the first iterate of an elastoplastic increment starts from the
-/// elastic predictor, relative residual ~0.3, and the plastic zone's points switch
+/// elastic predictor, relative residual ~0.3, and points at the plastic front switch
 /// between elastic and plastic in the first iterations), where a three-point estimate
-/// mixes the two regimes: e.g. 1.7e-2, 5.3e-4, 6.8e-6, 2.6e-11 gives 1.25 for the last
-/// triple although the last step is r⁺ = 0.56 r². Every increment with three residuals in
-/// the window must show an order >= 1.8 (measured: 1.9-5.3).
+/// mixes the two regimes. In that window the last observed order of every increment must
+/// be >= 1.75 and their median >= 1.9. Measured: worst 1.94, median 3.16 over the 18
+/// increments with three residuals in the window (with the line search and augmentation
+/// default of the robust-stepping solver; before them the worst was 1.78, residuals 4.1e-3,
+/// 8.8e-5, 9.5e-8: a quadratic step whose constant r⁺/r² grows from 5 to 12 while the
+/// plastic zone settles).
 #[test]
 fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
     let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 1.0), [20, 1, 3]).unwrap();
@@ -305,7 +334,8 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
     sim.run(|_, _| Ok(())).unwrap();
 
     let mut worst = f64::INFINITY;
-    let mut measured = 0;
+    let mut last_orders = Vec::new();
+    let mut quadratic_constant: f64 = 0.0;
     for r in &sim.history {
         let res: Vec<f64> = r
             .residuals
@@ -315,14 +345,26 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
             .collect();
         let orders = common::convergence_orders(&res, 1e-10);
         println!(
-            "increment {:2}: {:2} iterations, orders {:.2?}",
-            r.index, r.iterations, orders
+            "increment {:2}: {:2} iterations, orders {:.2?}, residuals {:?}",
+            r.index,
+            r.iterations,
+            orders,
+            r.residuals
+                .iter()
+                .map(|x| format!("{:.1e}", x.force_rel))
+                .collect::<Vec<_>>()
         );
         if let Some(&last) = orders.last() {
             worst = worst.min(last);
-            measured += 1;
+            last_orders.push(last);
+        }
+        for w in res.windows(2).filter(|w| w[1] > 1e-10) {
+            quadratic_constant = quadratic_constant.max(w[1] / (w[0] * w[0]));
         }
     }
+    let measured = last_orders.len();
+    last_orders.sort_by(f64::total_cmp);
+    let median = last_orders.get(measured / 2).copied().unwrap_or(0.0);
     let ep = sim
         .points()
         .iter()
@@ -332,9 +374,10 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
     let turn = (-end.z / (10.0 + end.x)).atan();
     let e = sim.energy();
     println!(
-        "{measured} increments with a measured order, worst {worst:.2}; max eq. plastic strain \
-         {ep:.4}, end displacement {end:?}, arm rotation {turn:.3} rad; support work {:.4}, \
-         elastic {:.4}, plastic {:.4}, balance {:e}",
+        "{measured} increments with a measured order, worst {worst:.2}, median {median:.2}, \
+         max r+/r^2 {quadratic_constant:.1}; max eq. plastic strain {ep:.4}, end displacement \
+         {end:?}, arm rotation {turn:.3} rad; support work {:.4}, elastic {:.4}, plastic {:.4}, \
+         balance {:e}",
         e.support_work, e.elastic_energy, e.plastic_dissipation, e.relative_error
     );
     assert!(ep > 0.05, "the strip yields");
@@ -343,9 +386,33 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
         measured >= 10,
         "{measured} increments with a measured order"
     );
-    assert!(worst >= 1.8, "observed order {worst}");
+    assert!(worst >= 1.75, "observed order {worst}");
+    assert!(median >= 1.9, "median observed order {median}");
     // Support work = stored + dissipated, to the trapezoidal rule's accuracy.
     assert!(e.relative_error.abs() < 1e-3, "{}", e.relative_error);
+}
+
+/// A plane-strain cantilever 10 x 1 x 2 (y held on both faces) of `cells` cells, clamped at
+/// x = 0, its tip face pulled down by `tip` over t in [0, 1].
+fn cantilever(cells: [usize; 3], material: ElastoPlastic, tip: f64) -> Model {
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 2.0), cells).unwrap();
+    let mut model = Model::new(mesh, Arc::new(material)).unwrap();
+    model
+        .prescribe("x-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    for set in ["y-", "y+"] {
+        model
+            .prescribe(set, "y", ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
+    model
+        .prescribe(
+            "x+",
+            "z",
+            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, -tip)]).unwrap(),
+        )
+        .unwrap();
+    model
 }
 
 /// A plane-strain cantilever (length 10, depth 2, clamped at x = 0) of a nearly
@@ -363,28 +430,12 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
 #[test]
 fn fbar_does_not_lock_in_nearly_incompressible_plastic_bending() {
     let tip_force = |cells: [usize; 3], fbar: bool| {
-        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 2.0), cells).unwrap();
         let m = ElastoPlastic::new(
             LinearElastic::new(YOUNG, 0.499).unwrap(),
             Hill48::von_mises(),
             Hardening::linear(200.0, 500.0).unwrap(),
         );
-        let mut model = Model::new(mesh, Arc::new(m)).unwrap();
-        model
-            .prescribe("x-", "xyz", ScalarSchedule::constant(0.0))
-            .unwrap();
-        for set in ["y-", "y+"] {
-            model
-                .prescribe(set, "y", ScalarSchedule::constant(0.0))
-                .unwrap();
-        }
-        model
-            .prescribe(
-                "x+",
-                "z",
-                ScalarSchedule::new(vec![(0.0, 0.0), (1.0, -1.0)]).unwrap(),
-            )
-            .unwrap();
+        let mut model = cantilever(cells, m, 1.0);
         model.settings.kinematics = StrainTheory::Finite;
         model.settings.fbar = fbar;
         model.settings.increments = 10;
@@ -413,4 +464,30 @@ fn fbar_does_not_lock_in_nearly_incompressible_plastic_bending() {
         locked_fine > 5.0 * reference,
         "32x8 without F-bar: {locked_fine}"
     );
+}
+
+/// Energy balance with plastic dissipation under small strain: with the trapezoidal rule
+/// for both the support work and the plastic dissipation, `½(σn + σn+1)·Δε` splits
+/// exactly into the elastic energy change and `½(σn + σn+1)·Δεp`, so the balance closes
+/// to the Newton tolerance on a plastic cantilever (B-bar, von Mises, Swift), although
+/// most of the work is dissipated.
+#[test]
+fn small_strain_energy_balance_includes_plastic_dissipation() {
+    let m = ElastoPlastic::new(
+        LinearElastic::new(YOUNG, POISSON).unwrap(),
+        Hill48::von_mises(),
+        Hardening::swift(SWIFT.0, SWIFT.1, SWIFT.2).unwrap(),
+    );
+    let mut model = cantilever([8, 1, 2], m, 0.5);
+    model.settings.increments = 10;
+    model.settings.force_rel_tol = 1e-12;
+    let mut sim = Simulation::new(model).unwrap();
+    sim.run(|_, _| Ok(())).unwrap();
+    let e = sim.energy();
+    println!(
+        "support work {:.6}, elastic {:.6}, plastic {:.6}, balance {:e}",
+        e.support_work, e.elastic_energy, e.plastic_dissipation, e.relative_error
+    );
+    assert!(e.plastic_dissipation > e.elastic_energy, "mostly plastic");
+    assert!(e.relative_error.abs() < 1e-9, "{}", e.relative_error);
 }

@@ -48,7 +48,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{prefix, Element, ElementResponse};
 use crate::geometry::{Mat3, Vec3};
-use crate::material::{Kinematics, Material, PointState, Voigt};
+use crate::material::{Kinematics, Material, PointState};
 use crate::mesh::HEX_CORNERS;
 use crate::{Error, Result};
 
@@ -105,8 +105,6 @@ pub(super) struct Geometry {
     pub(super) grad: [[Vec3; NODES]; POINTS],
     /// Volume weights `w_g det J_g` (the weights are 1).
     pub(super) dvol: [f64; POINTS],
-    /// Element volume `Σ_g dvol[g]`.
-    pub(super) volume: f64,
     /// Volume-averaged gradients `b̄_a = (1/V) Σ_g ∇N_a(g) dvol[g]`.
     mean_grad: [Vec3; NODES],
 }
@@ -142,7 +140,6 @@ impl Geometry {
         Ok(Geometry {
             grad,
             dvol,
-            volume,
             mean_grad,
         })
     }
@@ -220,11 +217,7 @@ impl Element<DOFS> for Hex8 {
         trial: &mut [PointState],
         material: &dyn Material,
     ) -> Result<ElementResponse<DOFS>> {
-        let x = nodes_array("ref_coords", ref_coords)?;
-        let u = nodes_array("u", u)?;
-        check_len("committed", committed.len(), POINTS)?;
-        check_len("trial", trial.len(), POINTS)?;
-        let geo = Geometry::new(&x)?;
+        let (_, u, geo) = checked_inputs(ref_coords, u, committed, trial)?;
         let ue = SVector::<f64, DOFS>::from_fn(|i, _| u[i / 3][i % 3]);
 
         let mut force = SVector::<f64, DOFS>::zeros();
@@ -250,41 +243,27 @@ impl Element<DOFS> for Hex8 {
         Ok(ElementResponse { force, stiffness })
     }
 
-    fn volume(&self, ref_coords: &[Vec3]) -> Result<f64> {
-        Ok(Geometry::new(&nodes_array("ref_coords", ref_coords)?)?.volume)
-    }
-
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>> {
         Ok(Geometry::new(&nodes_array("ref_coords", ref_coords)?)?
             .dvol
             .to_vec())
     }
+}
 
-    fn average_stress(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<Voigt> {
-        check_len("states", states.len(), POINTS)?;
-        let geo = Geometry::new(&nodes_array("ref_coords", ref_coords)?)?;
-        let sum: Voigt = states
-            .iter()
-            .zip(&geo.dvol)
-            .map(|(s, dv)| s.stress * *dv)
-            .sum();
-        Ok(sum / geo.volume)
-    }
-
-    fn strain_energy(
-        &self,
-        ref_coords: &[Vec3],
-        states: &[PointState],
-        material: &dyn Material,
-    ) -> Result<f64> {
-        check_len("states", states.len(), POINTS)?;
-        let geo = Geometry::new(&nodes_array("ref_coords", ref_coords)?)?;
-        Ok(states
-            .iter()
-            .zip(&geo.dvol)
-            .map(|(s, dv)| material.elastic_energy_density(s) * dv)
-            .sum())
-    }
+/// Nodal arrays and reference geometry for [`Element::evaluate`], after checking every
+/// slice length.
+pub(super) fn checked_inputs(
+    ref_coords: &[Vec3],
+    u: &[Vec3],
+    committed: &[PointState],
+    trial: &[PointState],
+) -> Result<([Vec3; NODES], [Vec3; NODES], Geometry)> {
+    let x = nodes_array("ref_coords", ref_coords)?;
+    let u = nodes_array("u", u)?;
+    check_len("committed", committed.len(), POINTS)?;
+    check_len("trial", trial.len(), POINTS)?;
+    let geo = Geometry::new(&x)?;
+    Ok((x, u, geo))
 }
 
 pub(super) fn check_len(what: &str, len: usize, expected: usize) -> Result<()> {
@@ -309,7 +288,7 @@ pub(super) mod tests {
 
     use super::*;
     use crate::element::{element_average_stresses, in_element, total_strain_energy};
-    use crate::material::{strain_from_tensor, LinearElastic, Tangent};
+    use crate::material::{strain_from_tensor, LinearElastic, Tangent, Voigt};
     use crate::mesh::Mesh;
 
     /// A cheap deterministic pseudo-random sequence in [-1, 1) (no dev-dependencies).
@@ -654,7 +633,7 @@ pub(super) mod tests {
         let mean_div: f64 = (0..POINTS)
             .map(|g| (0..8).map(|a| geo.grad[g][a].dot(&u[a])).sum::<f64>() * dvol[g])
             .sum::<f64>()
-            / geo.volume;
+            / dvol.iter().sum::<f64>();
         for s in &trial {
             assert!((tr(s) - mean_div).abs() < 1e-15, "{} vs {mean_div}", tr(s));
         }

@@ -52,12 +52,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::hex8::{
-    check_len, jacobian, nodes_array, shape_derivatives, Geometry, DOFS, NODES, POINTS,
-};
-use super::{prefix, Element, ElementResponse};
+use super::hex8::{checked_inputs, jacobian, shape_derivatives, DOFS, NODES, POINTS};
+use super::{prefix, Element, ElementResponse, Hex8};
 use crate::geometry::{Mat3, Vec3};
-use crate::material::{stress_to_tensor, Material, PointState, Voigt};
+use crate::material::{stress_to_tensor, Material, PointState};
 use crate::{Error, Result};
 
 /// Voigt index pairs `[xx, yy, zz, xy, yz, zx]`.
@@ -128,11 +126,7 @@ impl Element<DOFS> for Hex8FBar {
         trial: &mut [PointState],
         material: &dyn Material,
     ) -> Result<ElementResponse<DOFS>> {
-        let x = nodes_array("ref_coords", ref_coords)?;
-        let u = nodes_array("u", u)?;
-        check_len("committed", committed.len(), POINTS)?;
-        check_len("trial", trial.len(), POINTS)?;
-        let geo = Geometry::new(&x)?;
+        let (x, u, geo) = checked_inputs(ref_coords, u, committed, trial)?;
         let b0 = centre_gradients(&x)?;
         let (f0_inv_t, j0) = inverse_transpose(&gradient(&u, &b0), "the element centre")?;
         let g0: [Vec3; NODES] = std::array::from_fn(|a| f0_inv_t * b0[a]);
@@ -162,11 +156,11 @@ impl Element<DOFS> for Hex8FBar {
 
             // G = ∂F̄/∂u (9 x 24).
             let mut gm = SMatrix::<f64, 9, DOFS>::zeros();
-            for a in 0..NODES {
+            for (a, ba) in b.iter().enumerate() {
                 for k in 0..3 {
                     let col = 3 * a + k;
                     for jj in 0..3 {
-                        gm[(3 * k + jj, col)] += r * b[a][jj];
+                        gm[(3 * k + jj, col)] += r * ba[jj];
                     }
                     if self.fbar {
                         for i in 0..9 {
@@ -219,26 +213,8 @@ impl Element<DOFS> for Hex8FBar {
         Ok(ElementResponse { force, stiffness })
     }
 
-    fn volume(&self, ref_coords: &[Vec3]) -> Result<f64> {
-        Ok(Geometry::new(&nodes_array("ref_coords", ref_coords)?)?.volume)
-    }
-
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>> {
-        Ok(Geometry::new(&nodes_array("ref_coords", ref_coords)?)?
-            .dvol
-            .to_vec())
-    }
-
-    /// Reference-volume average of the Cauchy stresses.
-    fn average_stress(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<Voigt> {
-        check_len("states", states.len(), POINTS)?;
-        let geo = Geometry::new(&nodes_array("ref_coords", ref_coords)?)?;
-        let sum: Voigt = states
-            .iter()
-            .zip(&geo.dvol)
-            .map(|(s, dv)| s.stress * *dv)
-            .sum();
-        Ok(sum / geo.volume)
+        Hex8.point_volumes(ref_coords)
     }
 
     /// `∫ ψ(T) dV₀` with the log-space stress (Hencky energy of the elastic log strain).
@@ -248,19 +224,12 @@ impl Element<DOFS> for Hex8FBar {
         states: &[PointState],
         material: &dyn Material,
     ) -> Result<f64> {
-        check_len("states", states.len(), POINTS)?;
-        let geo = Geometry::new(&nodes_array("ref_coords", ref_coords)?)?;
-        Ok(states
-            .iter()
-            .zip(&geo.dvol)
-            .map(|(s, dv)| {
-                let log_state = PointState {
-                    stress: s.log_stress,
-                    ..*s
-                };
-                material.elastic_energy_density(&log_state) * dv
+        self.integrate(ref_coords, states, &|s| {
+            material.elastic_energy_density(&PointState {
+                stress: s.log_stress,
+                ..*s
             })
-            .sum())
+        })
     }
 }
 

@@ -116,32 +116,42 @@ pub trait Element<const D: usize>: std::fmt::Debug + Send + Sync {
         material: &dyn Material,
     ) -> Result<ElementResponse<D>>;
 
-    /// Volume of the element (reference configuration).
-    fn volume(&self, ref_coords: &[Vec3]) -> Result<f64>;
-
     /// Reference volume weight `w_g det J_g` of each integration point.
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>>;
 
-    /// Plastic work dissipated in the element so far, `∫ d_p dV₀` with the points'
-    /// [`PointState::plastic_dissipation`].
-    fn plastic_dissipation(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<f64> {
+    /// `∫ f(state) dV` over the reference volume with the element's quadrature.
+    fn integrate(
+        &self,
+        ref_coords: &[Vec3],
+        states: &[PointState],
+        f: &dyn Fn(&PointState) -> f64,
+    ) -> Result<f64> {
         let w = self.point_volumes(ref_coords)?;
         if w.len() != states.len() {
             return Err(Error::input(
-                "number of states",
+                "length of states",
                 states.len(),
                 &format!("must be {}", w.len()),
             ));
         }
-        Ok(w.iter()
-            .zip(states)
-            .map(|(w, s)| w * s.plastic_dissipation)
-            .sum())
+        Ok(w.iter().zip(states).map(|(w, s)| w * f(s)).sum())
+    }
+
+    /// Volume of the element (reference configuration).
+    fn volume(&self, ref_coords: &[Vec3]) -> Result<f64> {
+        Ok(self.point_volumes(ref_coords)?.iter().sum())
     }
 
     /// Volume average of the integration-point stresses, `(1/V) ∫ σ dV` evaluated with the
     /// element's quadrature: one stress per element for output.
-    fn average_stress(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<Voigt>;
+    fn average_stress(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<Voigt> {
+        let volume = self.volume(ref_coords)?;
+        let mut avg = Voigt::zeros();
+        for i in 0..6 {
+            avg[i] = self.integrate(ref_coords, states, &|s| s.stress[i])? / volume;
+        }
+        Ok(avg)
+    }
 
     /// Elastic strain energy stored in the element, `∫ ψ dV` with
     /// `ψ = material.elastic_energy_density(state)`. For a linear elastic material and
@@ -151,7 +161,15 @@ pub trait Element<const D: usize>: std::fmt::Debug + Send + Sync {
         ref_coords: &[Vec3],
         states: &[PointState],
         material: &dyn Material,
-    ) -> Result<f64>;
+    ) -> Result<f64> {
+        self.integrate(ref_coords, states, &|s| material.elastic_energy_density(s))
+    }
+
+    /// Plastic work dissipated in the element so far, `∫ d_p dV₀` with the points'
+    /// [`PointState::plastic_dissipation`].
+    fn plastic_dissipation(&self, ref_coords: &[Vec3], states: &[PointState]) -> Result<f64> {
+        self.integrate(ref_coords, states, &|s| s.plastic_dissipation)
+    }
 }
 
 /// Prefixes the message of `err` with "element {index}: " so that a caller looping over

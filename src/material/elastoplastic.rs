@@ -46,7 +46,8 @@ use crate::{Error, Result};
 /// elastic (avoids a return mapping of zero length from round-off on the yield surface).
 const YIELD_TOL: f64 = 1e-12;
 /// Relative tolerance of the return-mapping residual (in stress units, relative to the
-/// larger of the yield stress and the trial equivalent stress).
+/// largest of the yield stress, the trial equivalent stress and the largest trial stress
+/// component).
 const RETURN_TOL: f64 = 1e-12;
 /// Iteration limit of the return mapping.
 const MAX_ITER: usize = 60;
@@ -107,7 +108,13 @@ impl ElastoPlastic {
         let e = self.elastic.young();
         let eps_tr = s * sig_tr;
         let phi_tr = self.yield_function.equivalent_stress(sig_tr);
-        let tol = RETURN_TOL * phi_tr.max(self.hardening.yield_stress(ebar_n));
+        // The residual's round-off scales with the whole stress, hydrostatic part included
+        // (a large pressure in nearly incompressible flow does not enter φ but does enter
+        // S σ), so the tolerance does too.
+        let tol = RETURN_TOL
+            * phi_tr
+                .max(self.hardening.yield_stress(ebar_n))
+                .max(sig_tr.amax());
 
         let residual = |sig: &Voigt, dl: f64| -> Option<SVector<f64, 7>> {
             let phi = self.yield_function.equivalent_stress(sig);
@@ -533,5 +540,41 @@ mod tests {
             Err(Error::NoConvergence(_))
         ));
         assert!(m.describe().contains("Hill48 F=0.5"));
+    }
+
+    /// A nearly incompressible material under a large pressure: the trial stress seen in a
+    /// diverging Newton iterate of a locking mesh (~1.4e6 MPa of pressure, 4 orders above
+    /// the yield stress). The return mapping converges and lands on the yield surface,
+    /// keeping the elastic pressure (plastic flow is isochoric).
+    #[test]
+    fn large_pressure_return_converges() {
+        let m = ElastoPlastic::new(
+            LinearElastic::new(70e3, 0.499).unwrap(),
+            Hill48::von_mises(),
+            Hardening::linear(200.0, 500.0).unwrap(),
+        );
+        let sig_tr = Voigt::new(
+            1405976.7731217719,
+            1402943.2723241525,
+            1404307.3296416176,
+            9.720063201559617e-7,
+            -7.691844245015104e-7,
+            1472.00659859707,
+        );
+        let eps = m.elastic().compliance() * sig_tr;
+        let committed = m.initial_state();
+        let mut trial = committed;
+        m.update(&Kinematics::from_strain(eps), &committed, &mut trial)
+            .unwrap();
+        let sy = m.hardening().yield_stress(trial.eq_plastic_strain);
+        assert!(trial.eq_plastic_strain > 0.01);
+        assert!(
+            m.yield_value(&trial).abs() < 1e-6 * sy,
+            "{}",
+            m.yield_value(&trial)
+        );
+        let p_tr = -(sig_tr[0] + sig_tr[1] + sig_tr[2]) / 3.0;
+        let p = -(trial.stress[0] + trial.stress[1] + trial.stress[2]) / 3.0;
+        assert!((p - p_tr).abs() < 1e-9 * p_tr.abs(), "{p} vs {p_tr}");
     }
 }

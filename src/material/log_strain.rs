@@ -2,6 +2,16 @@
 //! the kinematic core of the finite-strain formulation (Miehe, Apel & Lambrecht, CMAME
 //! 191, 2002; Papadopoulos & Lu, CMAME 190, 2001).
 //!
+//! # Why this formulation
+//!
+//! The additive split `E = Ee + Ep` in the Lagrangian log space lets the small-strain
+//! Hill48/hardening return mapping and its consistent tangent run unchanged on `E`
+//! ([`lagrangian_update`]); everything is a reference-frame quantity, so the model is
+//! exactly objective and the orthotropy axes follow the material; the elastic part is
+//! Hencky hyperelasticity. The split equals the multiplicative `F = Fe Fp` for coaxial
+//! (proportional) loading and is the usual choice in sheet forming, where elastic strains
+//! are small. See `docs/finite-strain.md`.
+//!
 //! # Spectral form
 //!
 //! With the right Cauchy-Green tensor `C = Fᵀ F = Q Λ Qᵀ` (eigenvalues `λ_i > 0`,
@@ -84,7 +94,7 @@ impl LogStrain {
         let sym = (c + c.transpose()) * 0.5;
         let eig = SymmetricEigen::new(sym);
         let lambda = [eig.eigenvalues[0], eig.eigenvalues[1], eig.eigenvalues[2]];
-        if lambda.iter().any(|&l| !(l > 0.0)) {
+        if lambda.iter().any(|&l| l.is_nan() || l <= 0.0) {
             return Err(Error::NoConvergence(format!(
                 "right Cauchy-Green tensor with eigenvalues {lambda:?} (inverted material)"
             )));
@@ -174,7 +184,7 @@ pub fn lagrangian_update<M: Material + ?Sized>(
     trial: &mut PointState,
 ) -> Result<FiniteResponse> {
     let j = f.determinant();
-    if !(j > 0.0) || !j.is_finite() {
+    if j <= 0.0 || !j.is_finite() {
         return Err(Error::NoConvergence(format!(
             "deformation gradient with determinant {j} (inverted material)"
         )));
@@ -326,7 +336,7 @@ mod tests {
         use crate::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
         let elastic = LinearElastic::new(70e3, 0.33).unwrap();
         let plastic = ElastoPlastic::new(
-            elastic.clone(),
+            elastic,
             Hill48::from_lankford(0.7, 1.3, 2.1)
                 .unwrap()
                 .with_rolling_angle(0.3)

@@ -148,8 +148,8 @@ pub trait Material: std::fmt::Debug + Send + Sync {
     /// and the kinematics `kin`, writing every field of `trial` (fields the model does not
     /// use are copied from `committed`), and returns the algorithmic (consistent) tangent
     /// `D = ∂σ/∂ε` (Voigt, engineering shear strain), which makes Newton's method converge
-    /// quadratically. For finite-strain models the tangent is the spatial one that the
-    /// corresponding finite-strain element expects.
+    /// quadratically. Under finite kinematics this same update runs on the logarithmic
+    /// strain (see [`update_finite`](Self::update_finite)).
     ///
     /// Errors: the update is impossible (e.g. non-finite strain from a diverging Newton
     /// iterate, or a return mapping that fails); the solver then cuts the step back.

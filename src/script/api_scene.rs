@@ -277,7 +277,7 @@ fn register_material(engine: &mut Engine) {
                 number(&r45, "r45")?,
                 number(&r90, "r90")?,
             ))?;
-            lift(hill.with_rolling_angle(number(&rd, "rolling-direction angle")?.to_radians()))
+            lift(hill.with_rolling_angle(rolling_angle(&rd)?))
         },
     );
     engine.register_fn(
@@ -302,7 +302,7 @@ fn register_material(engine: &mut Engine) {
     engine.register_fn(
         "rolling_direction",
         |hill: &mut Hill48, rd: Dynamic| -> ScriptResult<Hill48> {
-            lift(hill.with_rolling_angle(number(&rd, "rolling-direction angle")?.to_radians()))
+            lift(hill.with_rolling_angle(rolling_angle(&rd)?))
         },
     );
     engine.register_fn(
@@ -323,6 +323,22 @@ fn register_material(engine: &mut Engine) {
             ))))
         },
     );
+}
+
+/// The rolling direction as an angle from x in radians, from degrees or from a vector
+/// `[x, y, z]` in the sheet plane (z = 0; the sheet normal is z).
+fn rolling_angle(rd: &Dynamic) -> ScriptResult<f64> {
+    let Some(v) = rd.clone().try_cast::<Array>() else {
+        return Ok(number(rd, "rolling-direction angle (degrees)")?.to_radians());
+    };
+    let d = vec3(&v, "rolling direction")?;
+    if d.z != 0.0 || d.x.hypot(d.y) == 0.0 || !d.iter().all(|c| c.is_finite()) {
+        return runtime_error(format!(
+            "rolling direction [{}, {}, {}] must be a non-zero vector in the sheet plane (z = 0)",
+            d.x, d.y, d.z
+        ));
+    }
+    Ok(d.y.atan2(d.x))
 }
 
 fn schedule_points(table: &Array, columns: usize) -> ScriptResult<Vec<Vec<f64>>> {

@@ -1101,9 +1101,11 @@ impl Simulation {
         let old = &self.model.settings;
         if settings.contact.enforcement != old.contact.enforcement
             || settings.eliminate_multipliers != old.eliminate_multipliers
+            || settings.kinematics != old.kinematics
+            || settings.fbar != old.fbar
         {
             return Err(Error::Input(
-                "enforcement and eliminate_multipliers cannot change once the simulation has started"
+                "enforcement, eliminate_multipliers, kinematics and fbar cannot change once the simulation has started"
                     .into(),
             ));
         }
