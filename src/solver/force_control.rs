@@ -88,7 +88,12 @@ pub fn offset(dofs: &DofMap, c: usize, x: &[f64]) -> f64 {
 /// `scheduled` moved by the offset of tool `c` in `x`.
 pub fn shifted(scheduled: &Pose, model: &Model, dofs: &DofMap, c: usize, x: &[f64]) -> Pose {
     match &model.contacts[c].tool.force_control {
-        Some(fc) => Pose::from_translation(scheduled.translation + fc.axis * offset(dofs, c, x)),
+        Some(fc) => {
+            // The offset moves the tool along its axis; a scheduled rotation stays.
+            let mut pose = *scheduled;
+            pose.translation += fc.axis * offset(dofs, c, x);
+            pose
+        }
         None => *scheduled,
     }
 }

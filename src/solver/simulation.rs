@@ -657,7 +657,15 @@ impl Simulation {
                     weights[off - n_u + 3 * k..off - n_u + 3 * k + 3].fill(*r);
                 }
             }
+            // A force-controlled tool's row stays out of the line search's merit (weight 0):
+            // its approach equation (the tool touching nothing yet) and its force equation
+            // take turns, and a merit seeing both would make the line search creep towards
+            // first touch.
         }
+        // While a force-controlled tool's force comes on, the body's residual rises from
+        // zero for several iterations by design: there, only a residual grown a millionfold
+        // counts as divergence, not a run of increases.
+        let force_controlled = self.dofs.tool_offset.iter().any(Option::is_some);
         let sizes: Vec<usize> = self
             .model
             .contacts
@@ -730,19 +738,24 @@ impl Simulation {
                     cycling_note()
                 )));
             }
-            // Growth is measured from the first non-zero residual: an increment driven only
-            // by a force-controlled tool starts from zero force residual.
+            // Growth is measured from the first residual above the tolerance: an increment
+            // driven only by a force-controlled tool starts from a zero (or round-off) force
+            // residual, which is no scale for growth.
             let first = residuals
                 .iter()
                 .map(|r| r.force_rel)
-                .find(|&v| v > 0.0)
-                .unwrap_or(1e-30);
+                .find(|&v| v > settings.force_rel_tol)
+                .unwrap_or(f64::INFINITY);
             let first_merit = merits.iter().copied().find(|&v| v > 0.0).unwrap_or(0.0);
-            let grew = merits.len() > window_start + DIVERGENCE_ITERATIONS
+            let grew = !force_controlled
+                && merits.len() > window_start + DIVERGENCE_ITERATIONS
                 && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
                     .windows(2)
                     .all(|w| w[1] > w[0])
-                && merit > first_merit;
+                && merit > first_merit
+                // Below the tolerance, growth is round-off (a force-controlled increment
+                // can sit there while its force row converges).
+                && !force_ok;
             if grew || (iterations >= 4 && rec.force_rel > 1e6 * first) {
                 return Err(Error::NoConvergence(format!(
                     "Newton diverges (force residual grew to {:.3e} relative); {}{}",
