@@ -6,7 +6,6 @@
 mod common;
 
 use tribo::geometry::{Plane, Vec3};
-use tribo::solver::linear::{FaerLu, LinearSolver};
 use tribo::solver::{Model, Simulation};
 use tribo::tool::{ForceControl, ScalarSchedule, Tool};
 
@@ -46,13 +45,7 @@ fn jacobian_with_offset_unknown_matches_finite_differences() {
     let s_dof = sim.unknowns().len() - 1;
     // First Newton iterate of the next increment: not converged, contact active, slipping.
     let t_new = sim.time() + 0.25;
-    let mut x = sim.unknowns().to_vec();
-    let e0 = sim.evaluate_at(t_new, &x).unwrap();
-    let mut dx: Vec<f64> = e0.residual.iter().map(|v| -v).collect();
-    FaerLu::default().solve(&e0.jacobian, &mut dx).unwrap();
-    for (a, b) in x.iter_mut().zip(&dx) {
-        *a += b;
-    }
+    let x = common::first_newton_iterate(&sim, t_new);
     let e = sim.evaluate_at(t_new, &x).unwrap();
     assert!(
         e.nodal[0]

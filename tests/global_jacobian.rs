@@ -4,7 +4,6 @@
 
 mod common;
 
-use tribo::solver::linear::{FaerLu, LinearSolver};
 use tribo::solver::Simulation;
 
 #[test]
@@ -45,13 +44,7 @@ fn check(mut model: tribo::solver::Model) -> Simulation {
     }
     // First Newton iterate of the next increment: not converged, contact active.
     let t_new = sim.time() + 0.25;
-    let mut x = sim.unknowns().to_vec();
-    let e0 = sim.evaluate_at(t_new, &x).unwrap();
-    let mut dx: Vec<f64> = e0.residual.iter().map(|v| -v).collect();
-    FaerLu::default().solve(&e0.jacobian, &mut dx).unwrap();
-    for (a, b) in x.iter_mut().zip(&dx) {
-        *a += b;
-    }
+    let x = common::first_newton_iterate(&sim, t_new);
     let e = sim.evaluate_at(t_new, &x).unwrap();
     let statuses: Vec<_> = e.nodal[0].iter().map(|(r, _)| r.status).collect();
     assert!(

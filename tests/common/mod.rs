@@ -136,3 +136,16 @@ pub fn full_and_condensed_steps(
         .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
     (full, condensed, scale, diff)
 }
+
+/// The first Newton iterate at time `t` from the committed state (one full mixed solve).
+pub fn first_newton_iterate(sim: &tribo::solver::Simulation, t: f64) -> Vec<f64> {
+    use tribo::solver::linear::{FaerLu, LinearSolver};
+    let mut x = sim.unknowns().to_vec();
+    let e0 = sim.evaluate_at(t, &x).unwrap();
+    let mut dx: Vec<f64> = e0.residual.iter().map(|v| -v).collect();
+    FaerLu::default().solve(&e0.jacobian, &mut dx).unwrap();
+    for (a, b) in x.iter_mut().zip(&dx) {
+        *a += b;
+    }
+    x
+}
