@@ -3,7 +3,6 @@
 
 mod common;
 
-use tribo::solver::linear::{FaerLu, LinearSolver};
 use tribo::solver::Simulation;
 
 fn drag(eliminate: bool) -> Simulation {
@@ -26,14 +25,7 @@ fn condensed_newton_step_equals_the_mixed_one() {
     let t_new = sim.time() + 0.25;
     let x = sim.unknowns().to_vec();
     let e = sim.evaluate_at(t_new, &x).unwrap();
-    let mut full: Vec<f64> = e.residual.iter().map(|v| -v).collect();
-    FaerLu::default().solve(&e.jacobian, &mut full).unwrap();
-    let condensed = sim.newton_step(&e, &mut FaerLu::default()).unwrap();
-    let scale = full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let diff = full
-        .iter()
-        .zip(&condensed)
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let (_, _, scale, diff) = common::full_and_condensed_steps(&sim, &e);
     println!("largest step entry {scale:.3e}, difference {diff:.3e}");
     assert!(diff < 1e-10 * scale, "condensed step differs by {diff:e}");
 }

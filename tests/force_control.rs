@@ -6,7 +6,6 @@
 mod common;
 
 use tribo::geometry::{Plane, Vec3};
-use tribo::solver::linear::{FaerLu, LinearSolver};
 use tribo::solver::{Model, Simulation};
 use tribo::tool::{ForceControl, ScalarSchedule, Tool};
 
@@ -46,13 +45,7 @@ fn jacobian_with_offset_unknown_matches_finite_differences() {
     let s_dof = sim.unknowns().len() - 1;
     // First Newton iterate of the next increment: not converged, contact active, slipping.
     let t_new = sim.time() + 0.25;
-    let mut x = sim.unknowns().to_vec();
-    let e0 = sim.evaluate_at(t_new, &x).unwrap();
-    let mut dx: Vec<f64> = e0.residual.iter().map(|v| -v).collect();
-    FaerLu::default().solve(&e0.jacobian, &mut dx).unwrap();
-    for (a, b) in x.iter_mut().zip(&dx) {
-        *a += b;
-    }
+    let x = common::first_newton_iterate(&sim, t_new);
     let e = sim.evaluate_at(t_new, &x).unwrap();
     assert!(
         e.nodal[0]
@@ -61,38 +54,19 @@ fn jacobian_with_offset_unknown_matches_finite_differences() {
         "some node slips"
     );
 
-    let n = x.len();
-    let mut fixed = vec![false; n];
-    for bc in &sim.model.dirichlet {
-        for &node in &bc.nodes {
-            fixed[3 * node + bc.component] = true;
-        }
-    }
     let scale = e.jacobian.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     // h = 1e-7 on O(1) unknowns: truncation O(h^2 |R'''|) and round-off O(eps |R| / h) are
     // both below 1e-8 of the largest entry; a missing term is of the size of the entries.
-    let h = 1e-7;
-    let mut worst = 0.0f64;
-    let mut worst_s_col = 0.0f64;
-    let mut s_col_size = 0.0f64;
-    for j in 0..n {
-        let (mut xp, mut xm) = (x.clone(), x.clone());
-        xp[j] += h;
-        xm[j] -= h;
-        let rp = sim.evaluate_at(t_new, &xp).unwrap().residual;
-        let rm = sim.evaluate_at(t_new, &xm).unwrap().residual;
-        let mut ej = vec![0.0; n];
-        ej[j] = 1.0;
-        let col = e.jacobian.mul_vec(&ej);
-        for i in (0..n).filter(|&i| !fixed[i]) {
-            let diff = ((rp[i] - rm[i]) / (2.0 * h) - col[i]).abs();
-            worst = worst.max(diff);
-            if j == s_dof {
-                worst_s_col = worst_s_col.max(diff);
-                s_col_size = s_col_size.max(col[i].abs());
-            }
-        }
-    }
+    let errors = common::jacobian_column_errors(&sim, t_new, &x, 1e-7);
+    let worst = errors.iter().fold(0.0f64, |m, v| m.max(*v));
+    let worst_s_col = errors[s_dof];
+    let mut ej = vec![0.0; x.len()];
+    ej[s_dof] = 1.0;
+    let s_col_size = e
+        .jacobian
+        .mul_vec(&ej)
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
     println!(
         "largest entry {scale:.3e}; worst difference {worst:.3e}; offset column: largest entry {s_col_size:.3e}, worst difference {worst_s_col:.3e}"
     );
@@ -101,6 +75,21 @@ fn jacobian_with_offset_unknown_matches_finite_differences() {
         worst < 1e-6 * scale,
         "assembled Jacobian differs from finite differences by {worst:e}"
     );
+}
+
+/// A frictionless plane punch at height `z`, facing down, pushed down by a force ramped
+/// from 0 to `force` over t in [0, 1].
+fn punch(z: f64, force: f64) -> Tool {
+    let plane = Plane::new(Vec3::new(0.0, 0.0, z), Vec3::new(0.0, 0.0, -1.0)).unwrap();
+    let mut punch = Tool::new("punch", std::sync::Arc::new(plane));
+    punch.force_control = Some(
+        ForceControl::new(
+            Vec3::new(0.0, 0.0, -1.0),
+            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, force)]).unwrap(),
+        )
+        .unwrap(),
+    );
+    punch
 }
 
 /// A frictionless rigid plane pushed with force F onto a block H high with cross-section A,
@@ -124,16 +113,9 @@ fn flat_punch(laterally_fixed: bool) {
         model.prescribe("x+", "x", zero.clone()).unwrap();
         model.prescribe("y+", "y", zero).unwrap();
     }
-    let plane = Plane::new(Vec3::new(0.0, 0.0, size.z + GAP), Vec3::new(0.0, 0.0, -1.0)).unwrap();
-    let mut punch = Tool::new("punch", std::sync::Arc::new(plane));
-    punch.force_control = Some(
-        ForceControl::new(
-            Vec3::new(0.0, 0.0, -1.0),
-            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, force)]).unwrap(),
-        )
-        .unwrap(),
-    );
-    model.add_tool(punch, "z+", None).unwrap();
+    model
+        .add_tool(punch(size.z + GAP, force), "z+", None)
+        .unwrap();
     model.settings.increments = 4;
     let contact_tol = model.settings.contact_tol;
     let r_sum: f64 = model.contacts[0].r.iter().sum();
@@ -207,16 +189,7 @@ fn condensed_floor_and_force_controlled_punch() {
         model
             .add_tool(Tool::new("floor", std::sync::Arc::new(floor)), "z-", None)
             .unwrap();
-        let plane = Plane::new(Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, -1.0)).unwrap();
-        let mut punch = Tool::new("punch", std::sync::Arc::new(plane));
-        punch.force_control = Some(
-            ForceControl::new(
-                Vec3::new(0.0, 0.0, -1.0),
-                ScalarSchedule::new(vec![(0.0, 0.0), (1.0, force)]).unwrap(),
-            )
-            .unwrap(),
-        );
-        model.add_tool(punch, "z+", None).unwrap();
+        model.add_tool(punch(1.0, force), "z+", None).unwrap();
         model.settings.increments = 2;
         model.settings.eliminate_multipliers = eliminate;
         let mut sim = Simulation::new(model).unwrap();
@@ -267,14 +240,7 @@ fn condensed_step_with_force_control_equals_the_mixed_one() {
         for iterate in 0..2 {
             let e = sim.evaluate_at(t_new, &x).unwrap();
             seen.extend(e.nodal[0].iter().map(|(r, _)| r.status));
-            let mut full: Vec<f64> = e.residual.iter().map(|v| -v).collect();
-            FaerLu::default().solve(&e.jacobian, &mut full).unwrap();
-            let condensed = sim.newton_step(&e, &mut FaerLu::default()).unwrap();
-            let scale = full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let diff = full
-                .iter()
-                .zip(&condensed)
-                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let (full, condensed, scale, diff) = common::full_and_condensed_steps(&sim, &e);
             let n = full.len();
             println!(
                 "t = {t_new}, iterate {iterate}: largest step entry {scale:.3e}, difference {diff:.3e}; offset step {:.6e} vs {:.6e}",

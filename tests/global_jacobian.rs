@@ -4,7 +4,6 @@
 
 mod common;
 
-use tribo::solver::linear::{FaerLu, LinearSolver};
 use tribo::solver::Simulation;
 
 #[test]
@@ -45,13 +44,7 @@ fn check(mut model: tribo::solver::Model) -> Simulation {
     }
     // First Newton iterate of the next increment: not converged, contact active.
     let t_new = sim.time() + 0.25;
-    let mut x = sim.unknowns().to_vec();
-    let e0 = sim.evaluate_at(t_new, &x).unwrap();
-    let mut dx: Vec<f64> = e0.residual.iter().map(|v| -v).collect();
-    FaerLu::default().solve(&e0.jacobian, &mut dx).unwrap();
-    for (a, b) in x.iter_mut().zip(&dx) {
-        *a += b;
-    }
+    let x = common::first_newton_iterate(&sim, t_new);
     let e = sim.evaluate_at(t_new, &x).unwrap();
     let statuses: Vec<_> = e.nodal[0].iter().map(|(r, _)| r.status).collect();
     assert!(
@@ -61,29 +54,10 @@ fn check(mut model: tribo::solver::Model) -> Simulation {
         "some node slips"
     );
 
-    let n = x.len();
-    let mut fixed = vec![false; n];
-    for bc in &sim.model.dirichlet {
-        for &node in &bc.nodes {
-            fixed[3 * node + bc.component] = true;
-        }
-    }
     let scale = e.jacobian.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let h = 1e-7;
-    let mut worst = 0.0f64;
-    for j in 0..n {
-        let (mut xp, mut xm) = (x.clone(), x.clone());
-        xp[j] += h;
-        xm[j] -= h;
-        let rp = sim.evaluate_at(t_new, &xp).unwrap().residual;
-        let rm = sim.evaluate_at(t_new, &xm).unwrap().residual;
-        let mut ej = vec![0.0; n];
-        ej[j] = 1.0;
-        let col = e.jacobian.mul_vec(&ej);
-        for i in (0..n).filter(|&i| !fixed[i]) {
-            worst = worst.max(((rp[i] - rm[i]) / (2.0 * h) - col[i]).abs());
-        }
-    }
+    let worst = common::jacobian_column_errors(&sim, t_new, &x, 1e-7)
+        .into_iter()
+        .fold(0.0f64, f64::max);
     println!(
         "largest Jacobian entry {scale:.3e}, worst difference to finite differences {worst:.3e}"
     );

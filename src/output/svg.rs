@@ -192,6 +192,11 @@ fn text(out: &mut String, x: f64, y: f64, size: f64, anchor: &str, extra: &str, 
     );
 }
 
+/// A y-axis tick label left of the axis at `x_axis`, centred on height `y`.
+fn y_tick_label(out: &mut String, x_axis: f64, y: f64, label: &str) {
+    text(out, x_axis - 8.0, y + 4.0, 12.0, "end", "", label);
+}
+
 impl LineChart {
     fn check(&self) -> Result<()> {
         if self.series.is_empty() {
@@ -286,15 +291,7 @@ impl LineChart {
             );
         }
         for &t in &yt {
-            text(
-                &mut out,
-                left - 8.0,
-                sy(t) + 4.0,
-                12.0,
-                "end",
-                "",
-                &tick_label(t, ys),
-            );
+            y_tick_label(&mut out, left, sy(t), &tick_label(t, ys));
         }
         text(
             &mut out,
@@ -577,15 +574,7 @@ impl FieldMap {
                 px(sy(t)),
                 px(left)
             );
-            text(
-                &mut out,
-                left - 8.0,
-                sy(t) + 4.0,
-                12.0,
-                "end",
-                "",
-                &tick_label(t, ys),
-            );
+            y_tick_label(&mut out, left, sy(t), &tick_label(t, ys));
         }
         text(
             &mut out,

@@ -231,8 +231,8 @@ impl Condenser {
                 let ri = self.reduced_index[ua + alpha].expect("displacements stay");
                 rhs[ri] =
                     -r * residual[l + alpha] + (0..3).map(|b| m[alpha][b] * rhs1[b]).sum::<f64>();
-                for beta in 0..3 {
-                    self.add_k_row(&mut a, j, ri, e, beta, m[alpha][beta]);
+                for (beta, &m_ab) in m[alpha].iter().enumerate() {
+                    self.add_k_row(&mut a, j, ri, e, beta, m_ab);
                 }
                 // r S: E_x on the node's own displacements (and E_s on a tool offset).
                 for &(col, k) in &self.rows[l + alpha] {
