@@ -386,7 +386,7 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
         measured >= 10,
         "{measured} increments with a measured order"
     );
-    assert!(worst >= 1.75, "observed order {worst}");
+    assert!(worst >= 1.8, "observed order {worst}");
     assert!(median >= 1.9, "median observed order {median}");
     // Support work = stored + dissipated, to the trapezoidal rule's accuracy.
     assert!(e.relative_error.abs() < 1e-3, "{}", e.relative_error);
