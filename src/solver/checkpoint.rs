@@ -39,7 +39,7 @@ pub struct SavedState {
     pub energy: EnergyBalance,
     pub energy_memory: EnergyMemory,
     pub controller: StepController,
-    /// The last increment's (dt, change of the unknowns), for the extrapolating predictor.
+    /// The last increment's (dt, change of the displacements), for the extrapolating predictor.
     #[serde(default)]
     pub last_step: Option<(f64, Vec<f64>)>,
 }

@@ -124,7 +124,8 @@ pub struct Simulation {
     stops: Vec<f64>,
     /// Committed states before the last increments, for `rollback`.
     saved: VecDeque<SavedState>,
-    /// Last converged increment (dt, change of the unknowns), for the extrapolating predictor.
+    /// Last converged increment (dt, change of the displacements), for the extrapolating
+    /// predictor.
     last_step: Option<(f64, Vec<f64>)>,
 }
 
@@ -681,7 +682,7 @@ impl Simulation {
         // active set, tens of iterations on a drawn sheet).
         if let (true, Some((dt_last, dx))) = (settings.extrapolate, &self.last_step) {
             let ratio = (t_new - self.time) / dt_last;
-            for (xi, d) in x[..n_u].iter_mut().zip(&dx[..n_u]) {
+            for (xi, d) in x[..n_u].iter_mut().zip(dx) {
                 *xi += ratio * d;
             }
         }
@@ -753,8 +754,7 @@ impl Simulation {
                     .windows(2)
                     .all(|w| w[1] > w[0])
                 && merit > first_merit
-                // Below the tolerance, growth is round-off (a force-controlled increment
-                // can sit there while its force row converges).
+                // Growth of a force residual already below its tolerance is round-off.
                 && !force_ok;
             if grew || (iterations >= 4 && rec.force_rel > 1e6 * first) {
                 return Err(Error::NoConvergence(format!(
@@ -989,7 +989,9 @@ impl Simulation {
             .map(|c| force_control::offset(&self.dofs, c, &x))
             .collect();
         let dt = t_new - self.time;
-        self.last_step = Some((dt, x.iter().zip(&self.x).map(|(a, b)| a - b).collect()));
+        let n_u = 3 * self.dofs.n_nodes;
+        let du = x[..n_u].iter().zip(&self.x[..n_u]).map(|(a, b)| a - b);
+        self.last_step = Some((dt, du.collect()));
         self.x = x;
         self.points = eval.trial_points;
         self.time = t_new;
