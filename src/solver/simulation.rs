@@ -311,11 +311,13 @@ impl Simulation {
 
     /// Solves J dx = -R, through the condensed system when multipliers are eliminated.
     pub fn newton_step(&self, eval: &Evaluation, linear: &mut FaerLu) -> Result<Vec<f64>> {
+        // Tool offsets couple to every node of their tool: kept out of the sparse LU.
+        let border: Vec<usize> = self.dofs.tool_offset.iter().flatten().copied().collect();
         match &self.condenser {
-            Some(c) => c.solve(&eval.jacobian, &eval.residual, linear),
+            Some(c) => c.solve(&eval.jacobian, &eval.residual, &border, linear),
             None => {
                 let mut rhs: Vec<f64> = eval.residual.iter().map(|v| -v).collect();
-                linear.solve(&eval.jacobian, &mut rhs)?;
+                linear.solve_bordered(&eval.jacobian, &mut rhs, &border)?;
                 Ok(rhs)
             }
         }
@@ -586,12 +588,19 @@ impl Simulation {
         let contact = eval.residual[n_u..]
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()));
-        // Merit: the full residual with the contact rows (lengths) scaled by r (forces).
+        // Merit: the full residual with the contact rows (lengths) scaled by r (forces). An
+        // approach row is a travel to first touch, not an error to reduce: left out.
+        let approach_rows: Vec<usize> = (0..self.model.contacts.len())
+            .filter(|&c| force_control::approaching(&self.model, c, &eval.nodal))
+            .filter_map(|c| self.dofs.tool_offset[c])
+            .collect();
         let merit = (force * force
             + eval.residual[n_u..]
                 .iter()
                 .zip(weights)
-                .map(|(v, w)| (v * w).powi(2))
+                .enumerate()
+                .filter(|(i, _)| !approach_rows.contains(&(n_u + i)))
+                .map(|(_, (v, w))| (v * w).powi(2))
                 .sum::<f64>())
         .sqrt();
         (
@@ -658,10 +667,12 @@ impl Simulation {
                     weights[off - n_u + 3 * k..off - n_u + 3 * k + 3].fill(*r);
                 }
             }
-            // A force-controlled tool's row stays out of the line search's merit (weight 0):
-            // its approach equation (the tool touching nothing yet) and its force equation
-            // take turns, and a merit seeing both would make the line search creep towards
-            // first touch.
+            // A force-controlled tool's force row (a length: force error / r_s) enters the
+            // merit times r_s, as a force error; its approach row does not (see
+            // `residual_record`).
+            if let Some(s) = self.dofs.tool_offset[c] {
+                weights[s - n_u] = force_control::row_scale(&self.model, c);
+            }
         }
         // While a force-controlled tool's force comes on, the body's residual rises from
         // zero for several iterations by design: there, only a residual grown a millionfold
@@ -767,11 +778,15 @@ impl Simulation {
             let ts = Instant::now();
             let dx = self.newton_step(&eval, linear)?;
             times.factorization_and_solve += ts.elapsed().as_secs_f64();
+            // A step that brings a force-controlled tool to first touch is taken whole: the
+            // merit cannot judge it (its force row only starts to count once touching).
+            let approach = (0..self.model.contacts.len())
+                .any(|c| force_control::approaching(&self.model, c, &eval.nodal));
             let (x_new, eval_new, cuts) = self.line_search(
                 &ctx,
                 &x,
                 &dx,
-                merit,
+                if approach { f64::INFINITY } else { merit },
                 monitor.damping(),
                 &weights,
                 &mut times,
