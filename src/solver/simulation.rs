@@ -25,6 +25,9 @@ use std::time::Instant;
 const DIVERGENCE_ITERATIONS: usize = 3;
 /// Halvings of the line search (smallest step 1/16 of the Newton step).
 const LINE_SEARCH_CUTS: usize = 4;
+/// How many times a converged frozen state may be released and frozen again in one
+/// increment (see `cycling`); after that the free law alone decides.
+const MAX_RELEASES: usize = 3;
 
 /// One Newton iteration's residual norms.
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
@@ -711,6 +714,7 @@ impl Simulation {
         let mut eval = ctx.evaluate(&x, &mut times)?;
         // Merits before a freeze belong to another problem: divergence is judged after it.
         let mut window_start = 0;
+        let mut releases = 0;
         loop {
             if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
                 ctx.forced = monitor.forced();
@@ -739,6 +743,16 @@ impl Simulation {
             let force_ok = rec.force <= settings.force_rel_tol * reference
                 || rec.force <= settings.force_abs_tol;
             if force_ok && rec.contact <= settings.contact_tol {
+                // Converged with frozen statuses: only the free law's solution counts, so
+                // Newton goes on unfrozen from this state, near the solution.
+                if ctx.forced.is_some() && releases < MAX_RELEASES {
+                    releases += 1;
+                    monitor.release(releases < MAX_RELEASES);
+                    ctx.forced = None;
+                    eval = ctx.evaluate(&x, &mut times)?;
+                    window_start = merits.len();
+                    continue;
+                }
                 break;
             }
             if iterations >= settings.max_iterations {
