@@ -40,6 +40,10 @@ pub struct HostOptions {
     pub restart_used: Rc<std::cell::Cell<bool>>,
     /// Print warnings of converged increments (status cycling, limits exceeded at dt_min).
     pub warnings: bool,
+    /// Settings given to every simulation the script creates, before the script's own
+    /// `sim.settings(...)` calls (same keys): how a study switches the method of a script
+    /// that does not declare the switch itself.
+    pub base_settings: rhai::Map,
 }
 
 impl Default for HostOptions {
@@ -53,6 +57,7 @@ impl Default for HostOptions {
             restart: None,
             restart_used: Rc::default(),
             warnings: true,
+            base_settings: rhai::Map::new(),
         }
     }
 }
