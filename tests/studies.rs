@@ -86,3 +86,16 @@ fn bad_study_input_gives_clear_errors() {
     assert!(page.contains("No study results yet"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_command_line_reports_an_unknown_study_without_panicking() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .args(["study", "no_such_study", "--quiet", "--out"])
+        .arg(std::env::temp_dir().join("tribo-study-cli"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("unknown study 'no_such_study'"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}

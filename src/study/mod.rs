@@ -12,6 +12,7 @@
 //! Wall time is the whole run (model set-up, every increment, and for the square cup the
 //! script and its output): the cost a user pays. It is measured on one thread; on a shared
 //! machine it varies by some 10 % (see BENCHMARKS.md), which the charts' log scale absorbs.
+//! Runs shorter than half a second are repeated and timed by their mean.
 
 pub mod chart;
 pub mod report;

@@ -46,6 +46,9 @@ fn short(reason: &str) -> String {
 fn case_section(o: &mut String, c: &CaseResult) {
     let _ = writeln!(o, "## {}\n", c.title);
     let _ = writeln!(o, "Error: {}.\n", c.error_measure);
+    if !c.notes.is_empty() {
+        let _ = writeln!(o, "{}\n", c.notes);
+    }
     let _ = writeln!(
         o,
         "![{0}](./{0}/work_precision.svg)\n\nPoints: [{0}/work_precision.csv](./{0}/work_precision.csv) (all runs: [{0}/results.json](./{0}/results.json)).\n",

@@ -106,6 +106,7 @@ fn measure(v: &CupVariant, scratch: &std::path::Path) -> Result<Measured> {
         progress: false,
         warnings: false,
         base_settings: base,
+        script_print: false,
         ..HostOptions::default()
     };
     let run = script::run_file(&path, &overrides, &host);
@@ -217,6 +218,7 @@ pub fn run(opts: &StudyOptions) -> Result<()> {
         title: format!("NUMISHEET'93 square cup, paper variant, punch to {TRAVEL} mm"),
         error_measure: "max(|DX - DX_ref| / DX_ref, |DD - DD_ref| / DD_ref, |F - F_ref| / F_ref): draw-in of the edge midpoint and of the corner, punch force at 15 mm, against the reference run (25 x 25 x 1, 0.25 mm increments)".into(),
         reference,
+        notes: "The layers family is measured against a one-layer reference: its error includes the change of the through-thickness model itself. Method switches that change only the Newton path (r of the augmented Lagrangian, curvature terms) give the same result as the default run on the same mesh.".into(),
         points,
         command: opts.command.clone(),
     };

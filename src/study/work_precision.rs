@@ -8,9 +8,10 @@
 //!   fit of the elliptic pressure profile to the nodal pressures), p0 the peak pressure.
 //! - Frictional-work ODE, against dPsi/ds = mu(Psi) N_node integrated by RK4 to round-off:
 //!   `e = |Psi_h(S) - Psi(S)| / Psi(S)` for the corner node's work after the whole slide S.
-//! - Cylinder drag (slip of four contact widths), against the reference run (finest mesh
-//!   and step): `e = max(|F_x - F_x,ref| / |F_x,ref|, |F_z - F_z,ref| / |F_z,ref|)` for the
-//!   roller force at the end of the drag (friction and normal force).
+//! - Cylinder drag (slip of four contact widths), against the reference run (finer mesh
+//!   and step than any of the families): `e = max(|D - D_ref| / D_ref, |Fz - Fz_ref| /
+//!   |Fz_ref|)`, D the frictional dissipation over the run and Fz the mean normal force
+//!   over the drag (trapezoidal over the increments).
 //! - Square cup (`square_cup.rs`): against the reference run, the largest relative
 //!   difference of the draw-ins DX and DD and of the punch force at the end.
 //!
@@ -66,9 +67,16 @@ pub struct CaseResult {
     pub error_measure: String,
     /// The run the others are compared with (None: an analytic solution).
     pub reference: Option<Point>,
+    /// What a reader must know to read the chart (known effects behind its shape).
+    #[serde(default)]
+    pub notes: String,
     pub points: Vec<Point>,
     pub command: String,
 }
+
+/// Runs shorter than this many seconds are repeated and timed by their mean.
+pub const MIN_TIMED: f64 = 0.5;
+const MAX_REPEATS: usize = 100;
 
 /// Measured values of one finished run and its cost (wall time set by the caller).
 pub type Measured = (Cost, BTreeMap<String, f64>);
@@ -81,8 +89,18 @@ pub fn run_point<V: Labelled>(
     opts: Option<&StudyOptions>,
 ) -> Point {
     let t = Instant::now();
-    let result = measure(v);
-    let wall = seconds(t);
+    let mut result = measure(v);
+    let mut wall = seconds(t);
+    // A run of a few milliseconds is timed as the mean of repeats filling `MIN_TIMED`
+    // seconds: one such run is at the mercy of the clock and the other core's load.
+    if result.is_ok() && wall < MIN_TIMED {
+        let mut runs = 1;
+        while seconds(t) < MIN_TIMED && runs < MAX_REPEATS {
+            result = measure(v);
+            runs += 1;
+        }
+        wall = seconds(t) / runs as f64;
+    }
     let point = match result {
         Ok((mut cost, values)) => {
             cost.wall_s = wall;
@@ -235,16 +253,18 @@ fn hertz_families() -> Vec<Family> {
 
 pub fn friction_work_measure(v: &Variant) -> Result<Measured> {
     let (sim, work) = scenes::friction_work(v)?;
-    let exact = scenes::ode_exact(scenes::corner_force(v.cells))?;
     Ok((
         Cost::of(&sim, 0.0),
-        values(&[("work", work), ("work_exact", exact)]),
+        values(&[("work", work), ("node_force", scenes::corner_force(v.cells))]),
     ))
 }
 
-/// `|Psi_h - Psi| / Psi`.
+/// `|Psi_h - Psi| / Psi`, the exact work integrated here (outside the timed run).
 pub fn friction_work_error(m: &BTreeMap<String, f64>, _: Option<&BTreeMap<String, f64>>) -> f64 {
-    rel(get(m, "work"), get(m, "work_exact"))
+    match scenes::ode_exact(get(m, "node_force")) {
+        Ok(exact) => rel(get(m, "work"), exact),
+        Err(_) => f64::NAN,
+    }
 }
 
 fn friction_work_families() -> Vec<Family> {
@@ -263,17 +283,6 @@ fn friction_work_families() -> Vec<Family> {
         update("explicit update", FrictionUpdate::Explicit),
         update("implicit update", FrictionUpdate::Implicit),
         Family {
-            name: "column mesh (implicit, 20 incr.)",
-            variants: [1, 2, 4]
-                .map(|c| {
-                    base.with(format!("{c}x{c} cells"), |v| {
-                        v.cells = c;
-                        v.contact.friction_update = FrictionUpdate::Implicit;
-                    })
-                })
-                .to_vec(),
-        },
-        Family {
             name: "penalty (explicit, 20 incr.)",
             variants: [1.0, 0.01].map(|f| penalty(&base, f)).to_vec(),
         },
@@ -286,13 +295,37 @@ pub fn drag_measure(v: &Variant) -> Result<Measured> {
     let mut sim = scenes::cylinder_drag(v, 0.2, 30, 4)?;
     sim.run(|_, _| Ok(()))?;
     let f = sim.tool_force(0);
-    Ok((Cost::of(&sim, 0.0), values(&[("force_x", f.x), ("force_z", f.z)])))
+    // Mean normal force over the drag (t in [1, 3]), trapezoidal over the increments.
+    let history: Vec<(f64, f64)> = sim
+        .history
+        .iter()
+        .map(|r| (r.time, r.tool_forces[0][2]))
+        .collect();
+    let mut mean_fz = 0.0;
+    for w in history.windows(2).filter(|w| w[0].0 >= 1.0 - 1e-12) {
+        mean_fz += 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0);
+    }
+    mean_fz /= 2.0;
+    Ok((
+        Cost::of(&sim, 0.0),
+        values(&[
+            ("dissipation", sim.energy().frictional_dissipation[0]),
+            ("mean_force_z", mean_fz),
+            ("final_force_x", f.x),
+            ("final_force_z", f.z),
+        ]),
+    ))
 }
 
-/// `max(|F_x - F_x,ref| / |F_x,ref|, |F_z - F_z,ref| / |F_z,ref|)` at the end of the drag.
+/// `max(|D - D_ref| / D_ref, |Fz - Fz_ref| / |Fz_ref|)`: frictional dissipation D over the
+/// whole run and mean normal force over the drag. Both integrate over the path, so they see
+/// the step size, and they average out the ripple of the force as the cylinder passes over
+/// the nodes (the final force alone swings by a few per cent with where the drag ends
+/// relative to the mesh).
 pub fn drag_error(m: &BTreeMap<String, f64>, r: Option<&BTreeMap<String, f64>>) -> f64 {
     let r = r.expect("the drag is measured against its reference run");
-    rel(get(m, "force_x"), get(r, "force_x")).max(rel(get(m, "force_z"), get(r, "force_z")))
+    rel(get(m, "dissipation"), get(r, "dissipation"))
+        .max(rel(get(m, "mean_force_z"), get(r, "mean_force_z")))
 }
 
 fn drag_families() -> Vec<Family> {
@@ -347,6 +380,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
             title: "Hertz line contact (rigid cylinder on an elastic block, plane strain)".into(),
             error_measure: "max(|a_h - a| / a, |p0_h - p0| / p0) against the closed form (half-width a, peak pressure p0)".into(),
             reference: None,
+            notes: "The problem is linear up to the contact zone, so the number of increments changes the cost only. Penalty at and above the default r gives errors of the size of the mesh error with either sign (the penetration widens the contact and offsets part of the coarse mesh's error); below it the penetration dominates.".into(),
             points: run_families(&hertz_families(), None, &hertz_measure, &hertz_error, Some(opts))?.1,
             command: opts.command.clone(),
         },
@@ -355,6 +389,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
             title: "Frictional-work ODE (column sliding 10 mm, Bernstein mu(work))".into(),
             error_measure: "|Psi_h - Psi| / Psi, corner node's frictional work after the slide, against RK4 of dPsi/ds = mu(Psi) N_node".into(),
             reference: None,
+            notes: "Every node slips exactly the prescribed distance, so the only error is the time discretisation of the friction update: first order explicit, second order implicit (tests/friction_work.rs). These runs last milliseconds; their wall time is the mean of repeats and mostly fixed set-up cost.".into(),
             points: run_families(&friction_work_families(), None, &friction_work_measure, &friction_work_error, Some(opts))?.1,
             command: opts.command.clone(),
         },
@@ -365,8 +400,9 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
             CaseResult {
                 name: name.into(),
                 title: "Cylinder drag, slip of four contact widths (mu = 0.2)".into(),
-                error_measure: "max(|F_x - F_x,ref| / |F_x,ref|, |F_z - F_z,ref| / |F_z,ref|), roller force at the end of the drag, against the reference run (64 cells, 96 increments)".into(),
+                error_measure: "max(|D - D_ref| / D_ref, |Fz - Fz_ref| / |Fz_ref|), D the frictional dissipation over the run, Fz the mean normal force over the drag, against the reference run (64 cells, 96 increments)".into(),
                 reference,
+                notes: "The contact force ripples as the cylinder passes over the nodes (node-to-surface contact); the increments sample that ripple, and an increment that is a multiple of the cell size samples it at one phase only, so the error need not fall monotonically under step refinement on a fixed mesh, nor under mesh refinement at a fixed number of increments. The reference has an error of its own, so the errors of the finest runs are underestimated.".into(),
                 points,
                 command: opts.command.clone(),
             }
