@@ -55,8 +55,13 @@ pub fn log_log(
 ) -> String {
     let (width, height) = (1040.0, 560.0);
     let (left, right, top, bottom) = (80.0, 690.0, 50.0, 500.0);
-    let drawable = |p: &&(f64, f64, String)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
-    let (x0, x1) = decades(series.iter().flat_map(|s| s.points.iter().filter(drawable).map(|p| p.0)));
+    let drawable =
+        |p: &&(f64, f64, String)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
+    let (x0, x1) = decades(
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(drawable).map(|p| p.0)),
+    );
     let (y0, y1) = decades(
         series
             .iter()
@@ -74,12 +79,18 @@ pub fn log_log(
     text(&mut o, (left + right) / 2.0, 28.0, 16.0, "middle", title);
     for k in x0..=x1 {
         let x = sx(10f64.powi(k));
-        let _ = writeln!(o, "<line x1=\"{x:.1}\" y1=\"{top}\" x2=\"{x:.1}\" y2=\"{bottom}\" stroke=\"#dddddd\"/>");
+        let _ = writeln!(
+            o,
+            "<line x1=\"{x:.1}\" y1=\"{top}\" x2=\"{x:.1}\" y2=\"{bottom}\" stroke=\"#dddddd\"/>"
+        );
         text(&mut o, x, bottom + 18.0, 12.0, "middle", &decade_label(k));
     }
     for k in y0..=y1 {
         let y = sy(10f64.powi(k));
-        let _ = writeln!(o, "<line x1=\"{left}\" y1=\"{y:.1}\" x2=\"{right}\" y2=\"{y:.1}\" stroke=\"#dddddd\"/>");
+        let _ = writeln!(
+            o,
+            "<line x1=\"{left}\" y1=\"{y:.1}\" x2=\"{right}\" y2=\"{y:.1}\" stroke=\"#dddddd\"/>"
+        );
         text(&mut o, left - 6.0, y + 4.0, 12.0, "end", &decade_label(k));
     }
     let _ = writeln!(
@@ -88,7 +99,14 @@ pub fn log_log(
         right - left,
         bottom - top
     );
-    text(&mut o, (left + right) / 2.0, bottom + 42.0, 13.0, "middle", x_label);
+    text(
+        &mut o,
+        (left + right) / 2.0,
+        bottom + 42.0,
+        13.0,
+        "middle",
+        x_label,
+    );
     let _ = writeln!(
         o,
         "<text x=\"20\" y=\"{:.1}\" font-size=\"13\" {FONT} text-anchor=\"middle\" transform=\"rotate(-90 20 {:.1})\">{}</text>",
@@ -105,12 +123,22 @@ pub fn log_log(
         let colour = PALETTE[i % PALETTE.len()];
         let pts: Vec<&(f64, f64, String)> = s.points.iter().filter(drawable).collect();
         if pts.len() > 1 {
-            let path: Vec<String> = pts.iter().map(|p| format!("{:.1},{:.1}", sx(p.0), sy(p.1))).collect();
-            let _ = writeln!(o, "<polyline points=\"{}\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"1.5\"/>", path.join(" "));
+            let path: Vec<String> = pts
+                .iter()
+                .map(|p| format!("{:.1},{:.1}", sx(p.0), sy(p.1)))
+                .collect();
+            let _ = writeln!(
+                o,
+                "<polyline points=\"{}\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"1.5\"/>",
+                path.join(" ")
+            );
         }
         for p in &pts {
             let (x, y) = (sx(p.0), sy(p.1));
-            let _ = writeln!(o, "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"3.5\" fill=\"{colour}\"/>");
+            let _ = writeln!(
+                o,
+                "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"3.5\" fill=\"{colour}\"/>"
+            );
             text(&mut o, x + 5.0, y - 5.0, 9.0, "start", &p.2);
         }
         let ly = top + 10.0 + 18.0 * i as f64;
@@ -149,17 +177,32 @@ pub fn outcome_colour(o: Outcome) -> &'static str {
 
 /// Panels side by side (`per_row` of them per row), each a grid of coloured cells with the
 /// iteration count inside; a legend of the outcomes below.
-pub fn outcome_grid(title: &str, row_label: &str, col_label: &str, panels: &[Panel], per_row: usize) -> String {
+pub fn outcome_grid(
+    title: &str,
+    row_label: &str,
+    col_label: &str,
+    panels: &[Panel],
+    per_row: usize,
+) -> String {
     let (cell_w, cell_h) = (52.0, 30.0);
     let n_rows = panels.iter().map(|p| p.rows.len()).max().unwrap_or(1) as f64;
     let n_cols = panels.iter().map(|p| p.cols.len()).max().unwrap_or(1) as f64;
     let (pad_l, pad_t, gap) = (70.0, 40.0, 30.0);
-    let panel_w = pad_l + n_cols * cell_w + gap;
+    let (pad_t, title_lines) = (
+        pad_t + 14.0,
+        panels
+            .iter()
+            .map(|p| p.title.lines().count())
+            .max()
+            .unwrap_or(1) as f64,
+    );
+    let pad_t = pad_t + 14.0 * (title_lines - 1.0);
+    let panel_w = (pad_l + n_cols * cell_w + gap).max(330.0);
     let panel_h = pad_t + n_rows * cell_h + 50.0;
     let per_row = per_row.max(1);
     let grid_rows = panels.len().div_ceil(per_row).max(1) as f64;
     let width = 20.0 + per_row.min(panels.len().max(1)) as f64 * panel_w;
-    let height = 50.0 + grid_rows * panel_h + 50.0;
+    let height = 50.0 + grid_rows * panel_h + 60.0;
     let mut o = String::new();
     let _ = writeln!(
         o,
@@ -170,10 +213,27 @@ pub fn outcome_grid(title: &str, row_label: &str, col_label: &str, panels: &[Pan
     for (i, p) in panels.iter().enumerate() {
         let ox = 20.0 + (i % per_row) as f64 * panel_w;
         let oy = 50.0 + (i / per_row) as f64 * panel_h;
-        text(&mut o, ox + pad_l + p.cols.len() as f64 * cell_w / 2.0, oy + 14.0, 13.0, "middle", &p.title);
+        for (k, line) in p.title.lines().enumerate() {
+            let cx = ox + pad_l + p.cols.len() as f64 * cell_w / 2.0;
+            text(
+                &mut o,
+                cx,
+                oy + 14.0 + 16.0 * k as f64,
+                13.0,
+                "middle",
+                line,
+            );
+        }
         for (r, row) in p.cells.iter().enumerate() {
             let y = oy + pad_t + r as f64 * cell_h;
-            text(&mut o, ox + pad_l - 6.0, y + cell_h / 2.0 + 4.0, 11.0, "end", &p.rows[r]);
+            text(
+                &mut o,
+                ox + pad_l - 6.0,
+                y + cell_h / 2.0 + 4.0,
+                11.0,
+                "end",
+                &p.rows[r],
+            );
             for (c, (outcome, label)) in row.iter().enumerate() {
                 let outcome = *outcome;
                 let x = ox + pad_l + c as f64 * cell_w;
@@ -183,14 +243,35 @@ pub fn outcome_grid(title: &str, row_label: &str, col_label: &str, panels: &[Pan
                     outcome_colour(outcome),
                     outcome.name()
                 );
-                text(&mut o, x + cell_w / 2.0, y + cell_h / 2.0 + 4.0, 11.0, "middle", label);
+                text(
+                    &mut o,
+                    x + cell_w / 2.0,
+                    y + cell_h / 2.0 + 4.0,
+                    11.0,
+                    "middle",
+                    label,
+                );
             }
         }
         let yb = oy + pad_t + p.rows.len() as f64 * cell_h;
         for (c, label) in p.cols.iter().enumerate() {
-            text(&mut o, ox + pad_l + (c as f64 + 0.5) * cell_w, yb + 14.0, 11.0, "middle", label);
+            text(
+                &mut o,
+                ox + pad_l + (c as f64 + 0.5) * cell_w,
+                yb + 14.0,
+                11.0,
+                "middle",
+                label,
+            );
         }
-        text(&mut o, ox + pad_l + p.cols.len() as f64 * cell_w / 2.0, yb + 30.0, 11.0, "middle", col_label);
+        text(
+            &mut o,
+            ox + pad_l + p.cols.len() as f64 * cell_w / 2.0,
+            yb + 30.0,
+            11.0,
+            "middle",
+            col_label,
+        );
         let _ = writeln!(
             o,
             "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" {FONT} text-anchor=\"middle\" transform=\"rotate(-90 {:.1} {:.1})\">{}</text>",
@@ -201,7 +282,7 @@ pub fn outcome_grid(title: &str, row_label: &str, col_label: &str, panels: &[Pan
             xml_escape(row_label)
         );
     }
-    let ly = height - 25.0;
+    let ly = height - 40.0;
     let all = [
         Outcome::Converged,
         Outcome::ConvergedCycling,
@@ -211,11 +292,23 @@ pub fn outcome_grid(title: &str, row_label: &str, col_label: &str, panels: &[Pan
     ];
     let mut x = 20.0;
     for outcome in all {
-        let _ = writeln!(o, "<rect x=\"{x:.1}\" y=\"{:.1}\" width=\"14\" height=\"14\" fill=\"{}\"/>", ly - 11.0, outcome_colour(outcome));
+        let _ = writeln!(
+            o,
+            "<rect x=\"{x:.1}\" y=\"{:.1}\" width=\"14\" height=\"14\" fill=\"{}\"/>",
+            ly - 11.0,
+            outcome_colour(outcome)
+        );
         text(&mut o, x + 18.0, ly, 11.0, "start", outcome.name());
         x += 24.0 + 6.5 * outcome.name().len() as f64;
     }
-    text(&mut o, x + 10.0, ly, 11.0, "start", "(number: Newton iterations of the whole run; failed runs: the increment that failed)");
+    text(
+        &mut o,
+        20.0,
+        ly + 20.0,
+        11.0,
+        "start",
+        "number: Newton iterations of the whole run; iN: the run failed in increment N",
+    );
     o.push_str("</svg>\n");
     o
 }
@@ -245,7 +338,10 @@ mod tests {
         );
         assert!(s.starts_with("<svg") && s.ends_with("</svg>\n"));
         assert!(s.contains("t &lt;1&gt;"));
-        assert!(!s.contains(">zero<"), "a zero error is not drawn on a log axis");
+        assert!(
+            !s.contains(">zero<"),
+            "a zero error is not drawn on a log axis"
+        );
         let g = outcome_grid(
             "g",
             "r",
@@ -254,7 +350,10 @@ mod tests {
                 title: "p".into(),
                 rows: vec!["1".into()],
                 cols: vec!["a".into(), "b".into()],
-                cells: vec![vec![(Outcome::Converged, "3".into()), (Outcome::Diverged, "i2".into())]],
+                cells: vec![vec![
+                    (Outcome::Converged, "3".into()),
+                    (Outcome::Diverged, "i2".into()),
+                ]],
             }],
             2,
         );

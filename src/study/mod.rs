@@ -150,7 +150,8 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
 fn check_writable(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let probe = dir.join(".tribo_study_probe");
-    std::fs::write(&probe, b"").map_err(|e| Error::io(dir, format!("output folder is not writable: {e}")))?;
+    std::fs::write(&probe, b"")
+        .map_err(|e| Error::io(dir, format!("output folder is not writable: {e}")))?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
 }

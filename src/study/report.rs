@@ -71,12 +71,22 @@ fn case_section(o: &mut String, c: &CaseResult) {
                 .points
                 .iter()
                 .filter(|p| p.error.is_some())
-                .min_by(|a, b| a.error.unwrap_or(f64::MAX).total_cmp(&b.error.unwrap_or(f64::MAX)));
+                .min_by(|a, b| {
+                    a.error
+                        .unwrap_or(f64::MAX)
+                        .total_cmp(&b.error.unwrap_or(f64::MAX))
+                });
             let _ = writeln!(
                 o,
                 "**No run reached 1 %.** Smallest error: {}.\n",
-                best.map(|p| format!("{} ({}), {} in {:.2} s", p.label, p.family, fmt_err(p.error), p.cost.wall_s))
-                    .unwrap_or_else(|| "none converged".into())
+                best.map(|p| format!(
+                    "{} ({}), {} in {:.2} s",
+                    p.label,
+                    p.family,
+                    fmt_err(p.error),
+                    p.cost.wall_s
+                ))
+                .unwrap_or_else(|| "none converged".into())
             );
         }
     }
@@ -133,7 +143,15 @@ fn stability_section(o: &mut String, s: &StabilityResult) {
             methods.push(&c.method);
         }
     }
-    let _ = writeln!(o, "Where each method fails (every failing cell, by mu and r):\n");
+    let _ = writeln!(
+        o,
+        "Methods: the augmented Lagrangian (AL) or penalty enforcement; line search: backtracking on the residual norm; anti-cycling: a node whose contact status changes 3 times within an increment keeps its status (slip if slip took part, else stick) for the rest of the increment. No run may cut its step back, so a cell says whether its step size works as it is.\n"
+    );
+    let mut summary: Vec<String> = Vec::new();
+    let _ = writeln!(
+        o,
+        "Where each method fails (every failing cell, by mu and r):\n"
+    );
     let _ = writeln!(o, "| method | converged | failed | failing cells: mu, r / default: drag steps [mm] (outcome) |");
     let _ = writeln!(o, "|---|---|---|---|");
     for m in methods {
@@ -159,9 +177,32 @@ fn stability_section(o: &mut String, s: &StabilityResult) {
             "| {m} | {ok} of {} | {} | {} |",
             cells.len(),
             cells.len() - ok,
-            if groups.is_empty() { "none".to_string() } else { groups.join("; ") }
+            if groups.is_empty() {
+                "none".to_string()
+            } else {
+                groups.join("; ")
+            }
         );
+        // The largest r below every failure: the method's safe range on this grid.
+        let first_failing_r = cells
+            .iter()
+            .filter(|c| !c.outcome.converged())
+            .map(|c| c.r_factor)
+            .fold(f64::INFINITY, f64::min);
+        let safe = cells
+            .iter()
+            .map(|c| c.r_factor)
+            .filter(|&r| r < first_failing_r)
+            .fold(f64::NEG_INFINITY, f64::max);
+        summary.push(if first_failing_r.is_infinite() {
+            format!("- {m}: converges in every cell of the grid.")
+        } else if safe.is_finite() {
+            format!("- {m}: converges at every step size and mu for r up to {safe} x the default; first failure at r = {first_failing_r} x the default.")
+        } else {
+            format!("- {m}: fails already at the smallest r of the grid ({first_failing_r} x the default).")
+        });
     }
+    let _ = writeln!(o, "\nIn short:\n\n{}", summary.join("\n"));
     let frozen = s
         .cells
         .iter()

@@ -13,7 +13,11 @@ use crate::tool::{ScalarSchedule, Schedule, Tool};
 use crate::{Error, Result};
 use std::sync::Arc;
 
-fn tool(name: &str, surface: impl RigidSurface + 'static, path: &[(f64, [f64; 3])]) -> Result<Tool> {
+fn tool(
+    name: &str,
+    surface: impl RigidSurface + 'static,
+    path: &[(f64, [f64; 3])],
+) -> Result<Tool> {
     let mut t = Tool::new(name, Arc::new(surface));
     t.schedule = Schedule::new(
         path.iter()
@@ -186,7 +190,9 @@ pub fn friction_work(v: &Variant) -> Result<(Simulation, f64)> {
         .candidates
         .iter()
         .position(|&n| sim.model.mesh.nodes[n].norm() < 1e-12)
-        .ok_or_else(|| Error::Input("friction-work column: no contact node at the origin".into()))?;
+        .ok_or_else(|| {
+            Error::Input("friction-work column: no contact node at the origin".into())
+        })?;
     let work = sim.contact_states(0)[corner].work;
     Ok((sim, work))
 }

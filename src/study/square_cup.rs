@@ -118,8 +118,11 @@ fn measure(v: &CupVariant, scratch: &std::path::Path) -> Result<Measured> {
     run?;
     let s = summary.ok_or_else(|| Error::io(&summary_path, "no readable summary after the run"))?;
     let num = |v: &serde_json::Value, what: &str| {
-        v.as_f64()
-            .ok_or_else(|| Error::Input(format!("square cup summary: '{what}' missing or not a number")))
+        v.as_f64().ok_or_else(|| {
+            Error::Input(format!(
+                "square cup summary: '{what}' missing or not a number"
+            ))
+        })
     };
     if s["status"] != "finished" {
         return Err(Error::NoConvergence(format!(
@@ -137,7 +140,10 @@ fn measure(v: &CupVariant, scratch: &std::path::Path) -> Result<Measured> {
     let mut values = BTreeMap::new();
     values.insert("draw_in_dx_mm".into(), num(&draw["dx"], "draw_in dx")?);
     values.insert("draw_in_dd_mm".into(), num(&draw["dd"], "draw_in dd")?);
-    values.insert("punch_force_n".into(), num(&s["punch_force_peak_n"], "punch_force_peak_n")?);
+    values.insert(
+        "punch_force_n".into(),
+        num(&s["punch_force_peak_n"], "punch_force_peak_n")?,
+    );
     Ok((cost, values))
 }
 
@@ -211,7 +217,8 @@ pub fn run(opts: &StudyOptions) -> Result<()> {
     let scratch = dir.join("scratch");
     let measure = |v: &CupVariant| measure(v, &scratch);
     let reference = CupVariant::new("reference: 25x25, 0.25 mm", 25, 0.25);
-    let (reference, points) = run_families(&families(), Some(&reference), &measure, &error, Some(opts))?;
+    let (reference, points) =
+        run_families(&families(), Some(&reference), &measure, &error, Some(opts))?;
     let _ = std::fs::remove_dir_all(&scratch);
     let result = CaseResult {
         name: "square_cup".into(),

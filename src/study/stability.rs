@@ -55,10 +55,14 @@ impl Grid {
             r_factors: vec![0.01, 0.1, 1.0, 10.0, 100.0],
             mus: vec![0.1, 0.3, 0.6],
             methods: vec![
-                al("AL, line search, statuses frozen on cycling", true, AntiCycling::Freeze),
-                al("AL, no line search, no anti-cycling", false, AntiCycling::Off),
+                al("AL + line search + anti-cycling", true, AntiCycling::Freeze),
+                al(
+                    "AL, no line search, no anti-cycling",
+                    false,
+                    AntiCycling::Off,
+                ),
                 Method {
-                    name: "penalty, line search, statuses frozen on cycling",
+                    name: "penalty + line search + anti-cycling",
                     enforcement: Enforcement::Penalty,
                     line_search: true,
                     anti_cycling: AntiCycling::Freeze,
@@ -185,12 +189,16 @@ fn write(grid: &Grid, result: &StabilityResult, opts: &StudyOptions) -> Result<(
                     grid.increments
                         .iter()
                         .map(|&n| {
-                            let c = result
-                                .cells
-                                .iter()
-                                .find(|c| c.method == m.name && c.mu == mu && c.r_factor == r && c.increments == n);
+                            let c = result.cells.iter().find(|c| {
+                                c.method == m.name
+                                    && c.mu == mu
+                                    && c.r_factor == r
+                                    && c.increments == n
+                            });
                             match c {
-                                Some(c) if c.outcome.converged() => (c.outcome, c.iterations.to_string()),
+                                Some(c) if c.outcome.converged() => {
+                                    (c.outcome, c.iterations.to_string())
+                                }
                                 Some(c) => (c.outcome, format!("i{}", c.increments_done + 1)),
                                 None => (Outcome::Diverged, "?".into()),
                             }
@@ -199,9 +207,18 @@ fn write(grid: &Grid, result: &StabilityResult, opts: &StudyOptions) -> Result<(
                 })
                 .collect();
             panels.push(Panel {
-                title: format!("{}, mu = {mu}", m.name),
-                rows: grid.r_factors.iter().rev().map(|r| format!("x {r}")).collect(),
-                cols: grid.increments.iter().map(|&n| format!("{:.2}", drag_step(n))).collect(),
+                title: format!("{}\nmu = {mu}", m.name),
+                rows: grid
+                    .r_factors
+                    .iter()
+                    .rev()
+                    .map(|r| format!("x {r}"))
+                    .collect(),
+                cols: grid
+                    .increments
+                    .iter()
+                    .map(|&n| format!("{:.2}", drag_step(n)))
+                    .collect(),
                 cells,
             });
         }

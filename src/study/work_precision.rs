@@ -78,8 +78,11 @@ pub struct CaseResult {
 pub const MIN_TIMED: f64 = 0.5;
 const MAX_REPEATS: usize = 100;
 
+/// Named measured values of a run.
+pub type Values = BTreeMap<String, f64>;
+
 /// Measured values of one finished run and its cost (wall time set by the caller).
-pub type Measured = (Cost, BTreeMap<String, f64>);
+pub type Measured = (Cost, Values);
 
 /// Runs one variant, timing it; a failed run gives its outcome and reason.
 pub fn run_point<V: Labelled>(
@@ -144,7 +147,7 @@ pub fn run_families<V: Labelled>(
     families: &[Family<V>],
     reference: Option<&V>,
     measure: &dyn Fn(&V) -> Result<Measured>,
-    error: &dyn Fn(&BTreeMap<String, f64>, Option<&BTreeMap<String, f64>>) -> f64,
+    error: &dyn Fn(&Values, Option<&Values>) -> f64,
     opts: Option<&StudyOptions>,
 ) -> Result<(Option<Point>, Vec<Point>)> {
     let reference = match reference {
@@ -231,7 +234,9 @@ fn hertz_families() -> Vec<Family> {
         },
         Family {
             name: "penalty (24 cells)",
-            variants: [100.0, 10.0, 1.0, 0.1, 0.01].map(|f| penalty(&base, f)).to_vec(),
+            variants: [100.0, 10.0, 1.0, 0.1, 0.01]
+                .map(|f| penalty(&base, f))
+                .to_vec(),
         },
         Family {
             name: "augmented Lagrangian r (24 cells)",
@@ -255,7 +260,10 @@ pub fn friction_work_measure(v: &Variant) -> Result<Measured> {
     let (sim, work) = scenes::friction_work(v)?;
     Ok((
         Cost::of(&sim, 0.0),
-        values(&[("work", work), ("node_force", scenes::corner_force(v.cells))]),
+        values(&[
+            ("work", work),
+            ("node_force", scenes::corner_force(v.cells)),
+        ]),
     ))
 }
 
@@ -402,7 +410,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
                 title: "Cylinder drag, slip of four contact widths (mu = 0.2)".into(),
                 error_measure: "max(|D - D_ref| / D_ref, |Fz - Fz_ref| / |Fz_ref|), D the frictional dissipation over the run, Fz the mean normal force over the drag, against the reference run (64 cells, 96 increments)".into(),
                 reference,
-                notes: "The contact force ripples as the cylinder passes over the nodes (node-to-surface contact); the increments sample that ripple, and an increment that is a multiple of the cell size samples it at one phase only, so the error need not fall monotonically under step refinement on a fixed mesh, nor under mesh refinement at a fixed number of increments. The reference has an error of its own, so the errors of the finest runs are underestimated.".into(),
+                notes: "The contact force ripples as the cylinder passes over the nodes (node-to-surface contact: on 32 cells the normal force is 68.4 with the cylinder over a node and 64.4 between two, in steady sliding); the increments sample that ripple, and an increment that is a multiple of the cell size samples it at one phase only, so the error need not fall monotonically under step refinement on a fixed mesh, nor under mesh refinement at a fixed number of increments. The reference has an error of its own, so the errors of the finest runs are underestimated.".into(),
                 points,
                 command: opts.command.clone(),
             }
@@ -481,7 +489,14 @@ pub fn points_csv(result: &CaseResult) -> String {
             p.error.map(|e| format!("{e:e}")).unwrap_or_default()
         );
         for k in &keys {
-            let _ = write!(o, ",{}", p.values.get(k).map(|v| format!("{v:e}")).unwrap_or_default());
+            let _ = write!(
+                o,
+                ",{}",
+                p.values
+                    .get(k)
+                    .map(|v| format!("{v:e}"))
+                    .unwrap_or_default()
+            );
         }
         o.push('\n');
     }
