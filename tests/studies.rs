@@ -62,7 +62,11 @@ fn penalty_error_grows_as_the_penalty_falls() {
     );
     // At 1/100 of the default r the penetration is the dominant error, several times the
     // mesh error of the augmented Lagrangian on the same mesh.
-    assert!(e[2] > 3.0 * exact, "penalty r x 0.01: {} vs AL {exact}", e[2]);
+    assert!(
+        e[2] > 3.0 * exact,
+        "penalty r x 0.01: {} vs AL {exact}",
+        e[2]
+    );
 }
 
 #[test]
@@ -71,7 +75,10 @@ fn bad_study_input_gives_clear_errors() {
     let mut opts = StudyOptions::new(&dir, "test");
     opts.progress = false;
     let e = tribo::study::run("hertzz", &opts).unwrap_err().to_string();
-    assert!(e.contains("unknown study 'hertzz'") && e.contains("friction_work"), "{e}");
+    assert!(
+        e.contains("unknown study 'hertzz'") && e.contains("friction_work"),
+        "{e}"
+    );
     // A file where the output folder should be.
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("not_a_folder");

@@ -133,13 +133,16 @@ pub fn log_log(
                 path.join(" ")
             );
         }
-        for p in &pts {
+        for (k, p) in pts.iter().enumerate() {
             let (x, y) = (sx(p.0), sy(p.1));
             let _ = writeln!(
                 o,
                 "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"3.5\" fill=\"{colour}\"/>"
             );
-            text(&mut o, x + 5.0, y - 5.0, 9.0, "start", &p.2);
+            // Labels alternate above and below their points: runs of one family often
+            // share an error and sit side by side.
+            let dy = if k % 2 == 0 { -5.0 } else { 13.0 };
+            text(&mut o, x + 5.0, y + dy, 9.0, "start", &p.2);
         }
         let ly = top + 10.0 + 18.0 * i as f64;
         let _ = writeln!(o, "<line x1=\"{}\" y1=\"{ly:.1}\" x2=\"{}\" y2=\"{ly:.1}\" stroke=\"{colour}\" stroke-width=\"3\"/>", right + 14.0, right + 34.0);

@@ -44,7 +44,7 @@ fn apply(model: &mut Model, v: &Variant) {
 /// Hertz case (as in `tests/hertz.rs`: a/R = 0.003, block 25 half-widths wide and deep).
 pub const HERTZ_E: f64 = 1000.0;
 pub const HERTZ_NU: f64 = 0.3;
-const HERTZ_R: f64 = 500.0;
+pub const HERTZ_R: f64 = 500.0;
 const HERTZ_SIZE: f64 = 40.0;
 const HERTZ_INDENT: f64 = 0.01;
 
@@ -90,8 +90,9 @@ pub fn hertz(v: &Variant) -> Result<(Simulation, HertzMeasure)> {
 /// a = sqrt(4 P R / (pi E*)), p0 = 2 P / (pi a), E* = E / (1 - nu^2). The FE half-width is
 /// the least-squares fit of p^2 = p0^2 (1 - x^2/a^2) to the nodal pressures lambda_n / A of
 /// the active nodes of the y = 0 row, leaving out the outermost one (its tributary strip
-/// straddles the edge); the FE peak pressure is the pressure at x = 0.
-fn hertz_measure(sim: &Simulation) -> Result<HertzMeasure> {
+/// straddles the edge); the FE peak pressure is the pressure at x = 0. For the Hertz
+/// scene's constants (any mesh of it, analytic or Bezier cylinder).
+pub fn hertz_measure(sim: &Simulation) -> Result<HertzMeasure> {
     let p = 2.0 * sim.tool_force(0).z;
     let e_star = HERTZ_E / (1.0 - HERTZ_NU * HERTZ_NU);
     let a_exact = (4.0 * p * HERTZ_R / (std::f64::consts::PI * e_star)).sqrt();
@@ -203,22 +204,30 @@ pub fn corner_force(cells: usize) -> f64 {
     ODE_N / (4.0 * n * n)
 }
 
-/// Psi(ODE_SLIDE) of dPsi/ds = mu(Psi) n_node by classical RK4 with 10^5 steps (error
-/// ~ h^4 ~ 1e-20 relative: exact for the study).
-pub fn ode_exact(n_node: f64) -> Result<f64> {
+/// Psi(s) of dPsi/ds = mu(Psi) n_node over the slide by classical RK4, sampled at
+/// `samples` + 1 equally spaced points, `steps` RK4 steps between samples.
+pub fn ode_work(n_node: f64, samples: usize, steps: usize) -> Result<Vec<f64>> {
     let law = ode_law()?;
     let f = |psi: f64| law.mu(psi, 1.0) * n_node;
-    let steps = 100_000;
-    let h = ODE_SLIDE / steps as f64;
+    let h = ODE_SLIDE / (samples * steps) as f64;
     let mut psi = 0.0;
-    for _ in 0..steps {
-        let k1 = f(psi);
-        let k2 = f(psi + 0.5 * h * k1);
-        let k3 = f(psi + 0.5 * h * k2);
-        let k4 = f(psi + h * k3);
-        psi += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    let mut out = vec![0.0];
+    for _ in 0..samples {
+        for _ in 0..steps {
+            let k1 = f(psi);
+            let k2 = f(psi + 0.5 * h * k1);
+            let k3 = f(psi + 0.5 * h * k2);
+            let k4 = f(psi + h * k3);
+            psi += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        }
+        out.push(psi);
     }
-    Ok(psi)
+    Ok(out)
+}
+
+/// Psi(ODE_SLIDE) with 10^5 RK4 steps (error ~ h^4 ~ 1e-20 relative: exact for the study).
+pub fn ode_exact(n_node: f64) -> Result<f64> {
+    Ok(ode_work(n_node, 1, 100_000)?[1])
 }
 
 // ---- cylinder drag --------------------------------------------------------------------------
