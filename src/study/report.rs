@@ -30,6 +30,15 @@ pub fn cheapest_accurate(points: &[Point]) -> Option<&Point> {
         .min_by(|a, b| a.cost.wall_s.total_cmp(&b.cost.wall_s))
 }
 
+/// Seconds with 3 significant digits below 1 s (the ODE's runs last milliseconds).
+fn fmt_s(t: f64) -> String {
+    if t < 1.0 {
+        format!("{t:.3}")
+    } else {
+        format!("{t:.2}")
+    }
+}
+
 fn fmt_err(e: Option<f64>) -> String {
     e.map(|e| format!("{e:.2e}")).unwrap_or_else(|| "-".into())
 }
@@ -58,11 +67,11 @@ fn case_section(o: &mut String, c: &CaseResult) {
         Some(p) => {
             let _ = writeln!(
                 o,
-                "**Cheapest run within 1 %:** {} ({}): error {}, {:.2} s, {} Newton iterations.\n",
+                "**Cheapest run within 1 %:** {} ({}): error {}, {} s, {} Newton iterations.\n",
                 p.label,
                 p.family,
                 fmt_err(p.error),
-                p.cost.wall_s,
+                fmt_s(p.cost.wall_s),
                 p.cost.iterations
             );
         }
@@ -80,11 +89,11 @@ fn case_section(o: &mut String, c: &CaseResult) {
                 o,
                 "**No run reached 1 %.** Smallest error: {}.\n",
                 best.map(|p| format!(
-                    "{} ({}), {} in {:.2} s",
+                    "{} ({}), {} in {} s",
                     p.label,
                     p.family,
                     fmt_err(p.error),
-                    p.cost.wall_s
+                    fmt_s(p.cost.wall_s)
                 ))
                 .unwrap_or_else(|| "none converged".into())
             );
@@ -102,10 +111,10 @@ fn case_section(o: &mut String, c: &CaseResult) {
     for p in &c.points {
         let _ = writeln!(
             o,
-            "| {} | {} | {:.2} | {} | {} ({}) | {} | {} |",
+            "| {} | {} | {} | {} | {} ({}) | {} | {} |",
             p.family,
             p.label,
-            p.cost.wall_s,
+            fmt_s(p.cost.wall_s),
             p.cost.iterations,
             p.cost.increments,
             p.cost.cutbacks,
@@ -183,24 +192,33 @@ fn stability_section(o: &mut String, s: &StabilityResult) {
                 groups.join("; ")
             }
         );
-        // The largest r below every failure: the method's safe range on this grid.
-        let first_failing_r = cells
-            .iter()
-            .filter(|c| !c.outcome.converged())
-            .map(|c| c.r_factor)
-            .fold(f64::INFINITY, f64::min);
-        let safe = cells
-            .iter()
-            .map(|c| c.r_factor)
-            .filter(|&r| r < first_failing_r)
-            .fold(f64::NEG_INFINITY, f64::max);
-        summary.push(if first_failing_r.is_infinite() {
-            format!("- {m}: converges in every cell of the grid.")
-        } else if safe.is_finite() {
-            format!("- {m}: converges at every step size and mu for r up to {safe} x the default; first failure at r = {first_failing_r} x the default.")
-        } else {
-            format!("- {m}: fails already at the smallest r of the grid ({first_failing_r} x the default).")
-        });
+        // Per r: in how many cells the method fails.
+        let mut rs: Vec<f64> = cells.iter().map(|c| c.r_factor).collect();
+        rs.sort_by(f64::total_cmp);
+        rs.dedup();
+        let (mut safe, mut failing) = (Vec::new(), Vec::new());
+        for r in rs {
+            let at_r: Vec<_> = cells.iter().filter(|c| c.r_factor == r).collect();
+            let bad = at_r.iter().filter(|c| !c.outcome.converged()).count();
+            if bad == 0 {
+                safe.push(format!("{r}"));
+            } else {
+                failing.push(format!("r x {r}: {bad} of {}", at_r.len()));
+            }
+        }
+        summary.push(format!(
+            "- {m}: converges at every step size and mu for r x {}; fails in {}.",
+            if safe.is_empty() {
+                "none".to_string()
+            } else {
+                safe.join(", ")
+            },
+            if failing.is_empty() {
+                "no cell".to_string()
+            } else {
+                failing.join(", ")
+            }
+        ));
     }
     let _ = writeln!(o, "\nIn short:\n\n{}", summary.join("\n"));
     let frozen = s
