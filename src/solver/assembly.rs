@@ -100,6 +100,78 @@ impl DofMap {
     }
 }
 
+/// Number of element threads for the setting `threads` (0: every core).
+fn element_threads(setting: usize) -> usize {
+    match setting {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    }
+}
+
+/// Evaluates every element at the unknowns `x`, on `threads` threads over contiguous
+/// blocks of elements, writing the trial states of their integration points. Each
+/// element's response is kept and returned in element order, so that the assembly (and
+/// hence every result) is the same whatever the thread count. The first failing element
+/// in element order is the one reported.
+fn evaluate_elements(
+    model: &Model,
+    x: &[f64],
+    committed: &[PointState],
+    trial: &mut [PointState],
+    threads: usize,
+) -> Result<Vec<ElementResponse<{ crate::element::hex8::DOFS }>>> {
+    let element = hexahedron(model.settings.kinematics, model.settings.fbar);
+    let per_elem = element.point_count();
+    let (hexes, nodes, material) = (
+        &model.mesh.hexes,
+        &model.mesh.nodes,
+        model.material.as_ref(),
+    );
+    let evaluate_block = |first: usize, trial: &mut [PointState]| {
+        let mut out = Vec::with_capacity(trial.len() / per_elem.max(1));
+        let mut xs = [Vec3::zeros(); 8];
+        let mut us = [Vec3::zeros(); 8];
+        for (k, trial_e) in trial.chunks_mut(per_elem).enumerate() {
+            let e = first + k;
+            for (a, &node) in hexes[e].iter().enumerate() {
+                xs[a] = nodes[node];
+                us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+            }
+            let committed_e = &committed[e * per_elem..(e + 1) * per_elem];
+            let response = element
+                .evaluate(&xs, &us, committed_e, trial_e, material)
+                .map_err(|err| Error::NoConvergence(in_element(err, e).to_string()))?;
+            out.push(response);
+        }
+        Ok::<_, Error>(out)
+    };
+    // Below a few dozen elements, starting threads costs more than it saves.
+    const MIN_PARALLEL_ELEMENTS: usize = 64;
+    if threads <= 1 || hexes.len() < MIN_PARALLEL_ELEMENTS {
+        return evaluate_block(0, trial);
+    }
+    let block = hexes.len().div_ceil(threads);
+    let blocks: Vec<Result<Vec<_>>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = trial
+            .chunks_mut(block * per_elem)
+            .enumerate()
+            .map(|(i, chunk)| {
+                let evaluate_block = &evaluate_block;
+                scope.spawn(move || evaluate_block(i * block, chunk))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    let mut all = Vec::with_capacity(hexes.len());
+    for b in blocks {
+        all.extend(b?);
+    }
+    Ok(all)
+}
+
 /// Wall time spent in each phase of assembly (seconds), accumulated.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PhaseTimes {
@@ -158,25 +230,14 @@ impl IncrementContext<'_> {
         let mut trial_points = self.committed_points.to_vec();
 
         let t0 = Instant::now();
-        let element = hexahedron(model.settings.kinematics, model.settings.fbar);
-        let per_elem = element.point_count();
-        let mut xs = [Vec3::zeros(); 8];
-        let mut us = [Vec3::zeros(); 8];
-        for (e, hex) in model.mesh.hexes.iter().enumerate() {
-            for (a, &node) in hex.iter().enumerate() {
-                xs[a] = model.mesh.nodes[node];
-                us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
-            }
-            let range = e * per_elem..(e + 1) * per_elem;
-            let ElementResponse { force, stiffness } = element
-                .evaluate(
-                    &xs,
-                    &us,
-                    &self.committed_points[range.clone()],
-                    &mut trial_points[range],
-                    model.material.as_ref(),
-                )
-                .map_err(|err| Error::NoConvergence(in_element(err, e).to_string()))?;
+        let responses = evaluate_elements(
+            model,
+            x,
+            self.committed_points,
+            &mut trial_points,
+            element_threads(model.settings.threads),
+        )?;
+        for (hex, ElementResponse { force, stiffness }) in model.mesh.hexes.iter().zip(&responses) {
             for (a, &na) in hex.iter().enumerate() {
                 for i in 0..3 {
                     f_int[3 * na + i] += force[3 * a + i];

@@ -183,11 +183,14 @@ impl Condenser {
         }
     }
 
-    /// Solves `J dx = -residual` through the reduced system; returns the full dx.
+    /// Solves `J dx = -residual` through the reduced system; returns the full dx. The
+    /// unknowns `border` (full indices, never eliminated multipliers) are solved by the
+    /// linear solver's Schur complement.
     pub fn solve(
         &self,
         j: &SparseMatrix,
         residual: &[f64],
+        border: &[usize],
         linear: &mut dyn LinearSolver,
     ) -> Result<Vec<f64>> {
         let n = j.pattern.n;
@@ -242,7 +245,11 @@ impl Condenser {
                 }
             }
         }
-        linear.solve(&a, &mut rhs)?;
+        let reduced_border: Vec<usize> = border
+            .iter()
+            .filter_map(|&d| self.reduced_index[d])
+            .collect();
+        linear.solve_bordered(&a, &mut rhs, &reduced_border)?;
         let mut dx = vec![0.0; n];
         for (d, ri) in self.reduced_index.iter().enumerate() {
             if let Some(ri) = ri {

@@ -10,10 +10,12 @@
 //! Treatment ([`AntiCycling`]): `Freeze` fixes the cycling node's status for the rest of
 //! the increment -- slip if slip took part in the cycle (the force then lies on the cone,
 //! so Coulomb's inequality holds), else stick (no penetration) -- so the remaining Newton
-//! problem is smooth near the solution and converges quadratically. The converged state
-//! satisfies the frozen law; how far it is from the free law (the residual of the
-//! unfrozen operator there) is reported with the nodes. `Damp` halves the Newton update
-//! while a node cycles instead.
+//! problem is smooth near the solution and converges quadratically. A state that satisfies
+//! only the frozen law is not a solution: Newton then releases every status
+//! ([`CyclingMonitor::release`]) and goes on with the free law from there, close to the
+//! solution; nodes that cycle again may be frozen again, a bounded number of times, after
+//! which the free law alone decides. `Damp` halves the Newton update while a node cycles
+//! instead.
 
 use super::step_control::AntiCycling;
 use crate::contact::ContactStatus;
@@ -23,6 +25,9 @@ use crate::contact::ContactStatus;
 pub struct CyclingMonitor {
     last: Vec<Vec<Option<ContactStatus>>>,
     flips: Vec<Vec<usize>>,
+    /// Flips counted, and statuses frozen, before the last release (for the report).
+    released_flips: Vec<Vec<usize>>,
+    released_frozen: Vec<Vec<Option<ContactStatus>>>,
     seen_slip: Vec<Vec<bool>>,
     /// Status imposed on each pair (None: free).
     pub frozen: Vec<Vec<Option<ContactStatus>>>,
@@ -46,6 +51,8 @@ impl CyclingMonitor {
         CyclingMonitor {
             last: sizes.iter().map(|&n| vec![None; n]).collect(),
             flips: sizes.iter().map(|&n| vec![0; n]).collect(),
+            released_flips: sizes.iter().map(|&n| vec![0; n]).collect(),
+            released_frozen: sizes.iter().map(|&n| vec![None; n]).collect(),
             seen_slip: sizes.iter().map(|&n| vec![false; n]).collect(),
             frozen: sizes.iter().map(|&n| vec![None; n]).collect(),
             treatment,
@@ -85,6 +92,26 @@ impl CyclingMonitor {
         newly_frozen
     }
 
+    /// Frees every frozen status and forgets the flips counted so far, so that Newton goes on
+    /// with the free law from where the frozen problem converged; `freeze_again`: whether
+    /// nodes that cycle once more may be frozen again.
+    pub fn release(&mut self, freeze_again: bool) {
+        for (past, now) in self.released_frozen.iter_mut().zip(&mut self.frozen) {
+            for (p, n) in past.iter_mut().zip(now.iter_mut()) {
+                *p = n.take().or(*p);
+            }
+        }
+        for (past, now) in self.released_flips.iter_mut().zip(&mut self.flips) {
+            for (p, n) in past.iter_mut().zip(now.iter_mut()) {
+                *p += *n;
+                *n = 0;
+            }
+        }
+        if !freeze_again {
+            self.treatment = AntiCycling::Off;
+        }
+    }
+
     /// Some node is cycling now (flipped at least `threshold` times).
     pub fn cycling(&self) -> bool {
         self.flips.iter().flatten().any(|&f| f >= self.threshold)
@@ -113,12 +140,15 @@ impl CyclingMonitor {
         let mut out = Vec::new();
         for (c, flips) in self.flips.iter().enumerate() {
             for (k, &f) in flips.iter().enumerate() {
+                let f = f + self.released_flips[c][k];
                 if f >= self.threshold {
                     out.push(CyclingNode {
                         tool: c,
                         node: node_of(c, k),
                         flips: f,
-                        frozen: self.frozen[c][k].map(|s| format!("{s:?}").to_lowercase()),
+                        frozen: self.frozen[c][k]
+                            .or(self.released_frozen[c][k])
+                            .map(|s| format!("{s:?}").to_lowercase()),
                     });
                 }
             }
@@ -159,5 +189,29 @@ mod tests {
         assert!(!d.observe(|_, _| Gap), "damping freezes nothing");
         assert_eq!(d.damping(), 0.5);
         assert!(d.forced().is_none());
+    }
+
+    #[test]
+    fn release_frees_the_statuses_and_keeps_the_report() {
+        let mut m = CyclingMonitor::new(&[1], AntiCycling::Freeze, 2);
+        for s in [Gap, Stick, Gap] {
+            m.observe(|_, _| s);
+        }
+        assert!(m.forced().is_some(), "frozen after two flips");
+        m.release(true);
+        assert!(m.forced().is_none(), "released: the free law decides");
+        let r = m.report(|_, k| k);
+        assert_eq!((r[0].flips, r[0].frozen.as_deref()), (2, Some("stick")));
+        // Flips are counted afresh: one more flip does not freeze it again...
+        assert!(!m.observe(|_, _| Stick));
+        // ...two do, while freezing again is allowed...
+        assert!(m.observe(|_, _| Gap));
+        // ...and after a final release nothing is frozen any more.
+        m.release(false);
+        for s in [Stick, Gap, Stick, Gap] {
+            assert!(!m.observe(|_, _| s));
+        }
+        assert!(m.forced().is_none());
+        assert_eq!(m.report(|_, k| k)[0].flips, 2 + 2 + 4);
     }
 }

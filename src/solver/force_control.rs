@@ -142,8 +142,19 @@ pub fn add_node_column(
     }
 }
 
+/// Whether tool `c` is force-controlled and touches no node in `nodal`: its row is then
+/// the approach equation, not the force equation.
+pub fn approaching(
+    model: &Model,
+    c: usize,
+    nodal: &[Vec<(NodalContact, Option<Projection>)>],
+) -> bool {
+    model.contacts[c].tool.force_control.is_some()
+        && !nodal[c].iter().any(|(r, _)| r.status.is_active())
+}
+
 /// Mean augmentation parameter of tool `c`: the scale of its force row.
-fn row_scale(model: &Model, c: usize) -> f64 {
+pub fn row_scale(model: &Model, c: usize) -> f64 {
     let r = &model.contacts[c].r;
     r.iter().sum::<f64>() / r.len().max(1) as f64
 }
@@ -167,7 +178,7 @@ pub fn add_force_rows(
         ) else {
             continue;
         };
-        if nodal[c].iter().any(|(r, _)| r.status.is_active()) {
+        if !approaching(model, c, nodal) {
             let r_s = row_scale(model, c);
             let mut pushed = 0.0;
             for k in 0..contact.candidates.len() {

@@ -75,6 +75,9 @@ pub struct SolverSettings {
     /// Start each increment's Newton iteration from the last increment's change of the
     /// displacements, scaled to the new step (off: from the committed state).
     pub extrapolate: bool,
+    /// Threads evaluating elements (0: as many as the machine has cores). The results do
+    /// not depend on it: elements are scattered into the global system in element order.
+    pub threads: usize,
 }
 
 impl Default for SolverSettings {
@@ -93,6 +96,7 @@ impl Default for SolverSettings {
             fbar: true,
             stepping: Default::default(),
             extrapolate: false,
+            threads: 0,
         }
     }
 }

@@ -25,6 +25,9 @@ use std::time::Instant;
 const DIVERGENCE_ITERATIONS: usize = 3;
 /// Halvings of the line search (smallest step 1/16 of the Newton step).
 const LINE_SEARCH_CUTS: usize = 4;
+/// How many times a converged frozen state may be released and frozen again in one
+/// increment (see `cycling`); after that the free law alone decides.
+const MAX_RELEASES: usize = 3;
 
 /// One Newton iteration's residual norms.
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
@@ -311,11 +314,13 @@ impl Simulation {
 
     /// Solves J dx = -R, through the condensed system when multipliers are eliminated.
     pub fn newton_step(&self, eval: &Evaluation, linear: &mut FaerLu) -> Result<Vec<f64>> {
+        // Tool offsets couple to every node of their tool: kept out of the sparse LU.
+        let border: Vec<usize> = self.dofs.tool_offset.iter().flatten().copied().collect();
         match &self.condenser {
-            Some(c) => c.solve(&eval.jacobian, &eval.residual, linear),
+            Some(c) => c.solve(&eval.jacobian, &eval.residual, &border, linear),
             None => {
                 let mut rhs: Vec<f64> = eval.residual.iter().map(|v| -v).collect();
-                linear.solve(&eval.jacobian, &mut rhs)?;
+                linear.solve_bordered(&eval.jacobian, &mut rhs, &border)?;
                 Ok(rhs)
             }
         }
@@ -586,12 +591,19 @@ impl Simulation {
         let contact = eval.residual[n_u..]
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()));
-        // Merit: the full residual with the contact rows (lengths) scaled by r (forces).
+        // Merit: the full residual with the contact rows (lengths) scaled by r (forces). An
+        // approach row is a travel to first touch, not an error to reduce: left out.
+        let approach_rows: Vec<usize> = (0..self.model.contacts.len())
+            .filter(|&c| force_control::approaching(&self.model, c, &eval.nodal))
+            .filter_map(|c| self.dofs.tool_offset[c])
+            .collect();
         let merit = (force * force
             + eval.residual[n_u..]
                 .iter()
                 .zip(weights)
-                .map(|(v, w)| (v * w).powi(2))
+                .enumerate()
+                .filter(|(i, _)| !approach_rows.contains(&(n_u + i)))
+                .map(|(_, (v, w))| (v * w).powi(2))
                 .sum::<f64>())
         .sqrt();
         (
@@ -658,10 +670,12 @@ impl Simulation {
                     weights[off - n_u + 3 * k..off - n_u + 3 * k + 3].fill(*r);
                 }
             }
-            // A force-controlled tool's row stays out of the line search's merit (weight 0):
-            // its approach equation (the tool touching nothing yet) and its force equation
-            // take turns, and a merit seeing both would make the line search creep towards
-            // first touch.
+            // A force-controlled tool's force row (a length: force error / r_s) enters the
+            // merit times r_s, as a force error; its approach row does not (see
+            // `residual_record`).
+            if let Some(s) = self.dofs.tool_offset[c] {
+                weights[s - n_u] = force_control::row_scale(&self.model, c);
+            }
         }
         // While a force-controlled tool's force comes on, the body's residual rises from
         // zero for several iterations by design: there, only a residual grown a millionfold
@@ -700,6 +714,7 @@ impl Simulation {
         let mut eval = ctx.evaluate(&x, &mut times)?;
         // Merits before a freeze belong to another problem: divergence is judged after it.
         let mut window_start = 0;
+        let mut releases = 0;
         loop {
             if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
                 ctx.forced = monitor.forced();
@@ -728,6 +743,16 @@ impl Simulation {
             let force_ok = rec.force <= settings.force_rel_tol * reference
                 || rec.force <= settings.force_abs_tol;
             if force_ok && rec.contact <= settings.contact_tol {
+                // Converged with frozen statuses: only the free law's solution counts, so
+                // Newton goes on unfrozen from this state, near the solution.
+                if ctx.forced.is_some() && releases < MAX_RELEASES {
+                    releases += 1;
+                    monitor.release(releases < MAX_RELEASES);
+                    ctx.forced = None;
+                    eval = ctx.evaluate(&x, &mut times)?;
+                    window_start = merits.len();
+                    continue;
+                }
                 break;
             }
             if iterations >= settings.max_iterations {
@@ -767,11 +792,15 @@ impl Simulation {
             let ts = Instant::now();
             let dx = self.newton_step(&eval, linear)?;
             times.factorization_and_solve += ts.elapsed().as_secs_f64();
+            // A step that brings a force-controlled tool to first touch is taken whole: the
+            // merit cannot judge it (its force row only starts to count once touching).
+            let approach = (0..self.model.contacts.len())
+                .any(|c| force_control::approaching(&self.model, c, &eval.nodal));
             let (x_new, eval_new, cuts) = self.line_search(
                 &ctx,
                 &x,
                 &dx,
-                merit,
+                if approach { f64::INFINITY } else { merit },
                 monitor.damping(),
                 &weights,
                 &mut times,

@@ -1,0 +1,78 @@
+//! The element loop runs on several threads (setting `threads`); every element's response
+//! is scattered in element order, so the results must be bit-for-bit those of one thread,
+//! whatever the number of threads (including counts that leave blocks of unequal size).
+//! The strip has 84 elements, above the 64 below which the loop stays on one thread.
+
+mod common;
+
+use std::sync::Arc;
+use tribo::element::StrainTheory;
+use tribo::geometry::{Cylinder, Vec3};
+use tribo::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
+use tribo::mesh::Mesh;
+use tribo::solver::{Model, Simulation};
+use tribo::tool::ScalarSchedule;
+
+/// A plastic strip (finite strain, Hill48, Swift) pressed into a rough cylinder and dragged:
+/// plastic flow and slip, so the integration-point states written by each thread matter.
+fn strip(threads: usize) -> (Vec<f64>, Vec<usize>) {
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 1.0), [21, 1, 4]).unwrap();
+    let material = ElastoPlastic::new(
+        LinearElastic::new(70e3, 0.33).unwrap(),
+        Hill48::from_lankford(0.7, 1.3, 2.1).unwrap(),
+        Hardening::swift(500.0, 0.01, 0.22).unwrap(),
+    );
+    let mut model = Model::new(mesh, Arc::new(material)).unwrap();
+    let cyl = Cylinder::new(Vec3::new(5.0, 0.0, 6.0 + 1e-3), Vec3::y(), 5.0).unwrap();
+    let path = [
+        (0.0, [0.0; 3]),
+        (1.0, [0.0, 0.0, -0.3]),
+        (2.0, [2.0, 0.0, -0.3]),
+    ];
+    model
+        .add_tool(common::tool("roller", cyl, &path, 0.2), "z+", None)
+        .unwrap();
+    model
+        .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    for set in ["y-", "y+"] {
+        model
+            .prescribe(set, "y", ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
+    model.settings.kinematics = StrainTheory::Finite;
+    model.settings.end_time = 2.0;
+    model.settings.increments = 8;
+    model.settings.threads = threads;
+    let mut sim = Simulation::new(model).unwrap();
+    sim.run(|_, _| Ok(())).unwrap();
+    let iterations = sim.history.iter().map(|r| r.iterations).collect();
+    (sim.unknowns().to_vec(), iterations)
+}
+
+#[test]
+fn results_do_not_depend_on_the_number_of_element_threads() {
+    let (one, its_one) = strip(1);
+    let plastic_or_moved = one.iter().any(|v| v.abs() > 1e-3);
+    assert!(
+        plastic_or_moved,
+        "the strip must deform for the test to mean anything"
+    );
+    for threads in [2, 5] {
+        let (many, its_many) = strip(threads);
+        assert_eq!(
+            its_one, its_many,
+            "{threads} threads: Newton iterations differ"
+        );
+        let worst = one
+            .iter()
+            .zip(&many)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        // Same operations in the same order: not round-off close, identical.
+        assert_eq!(
+            worst, 0.0,
+            "{threads} threads: unknowns differ by {worst:e}"
+        );
+    }
+}
