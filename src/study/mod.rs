@@ -161,7 +161,8 @@ fn check_writable(dir: &Path) -> Result<()> {
 pub enum Outcome {
     /// Reached the end; no contact status cycled.
     Converged,
-    /// Reached the end, with the anti-cycling treatment engaged in some increment.
+    /// Reached the end (satisfying the free contact law), with the anti-cycling treatment
+    /// engaged in some increment.
     ConvergedCycling,
     /// Stopped: Newton failed while some node's contact status cycled.
     Cycled,
@@ -192,7 +193,7 @@ impl Outcome {
     pub fn name(self) -> &'static str {
         match self {
             Outcome::Converged => "converged",
-            Outcome::ConvergedCycling => "converged (statuses frozen)",
+            Outcome::ConvergedCycling => "converged (anti-cycling engaged)",
             Outcome::Cycled => "cycled",
             Outcome::Diverged => "diverged",
             Outcome::Stalled => "stalled",

@@ -154,7 +154,7 @@ fn stability_section(o: &mut String, s: &StabilityResult) {
     }
     let _ = writeln!(
         o,
-        "Methods: the augmented Lagrangian (AL) or penalty enforcement; line search: backtracking on the residual norm; anti-cycling: a node whose contact status changes 3 times within an increment keeps its status (slip if slip took part, else stick) for the rest of the increment. No run may cut its step back, so a cell says whether its step size works as it is.\n"
+        "Methods: the augmented Lagrangian (AL) or penalty enforcement; line search: backtracking on the residual norm; anti-cycling: a node whose contact status changes 3 times within an increment has its status frozen (slip if slip took part, else stick) until Newton settles, then released, so that every accepted increment satisfies the free friction law. No run may cut its step back, so a cell says whether its step size works as it is.\n"
     );
     let mut summary: Vec<String> = Vec::new();
     let _ = writeln!(
@@ -228,7 +228,7 @@ fn stability_section(o: &mut String, s: &StabilityResult) {
         .count();
     let _ = writeln!(
         o,
-        "\n{frozen} converged cell(s) needed the anti-cycling treatment (statuses frozen in some increment).\n"
+        "\n{frozen} converged cell(s) needed the anti-cycling treatment in some increment.\n"
     );
 }
 

@@ -29,7 +29,10 @@ fn tool(
 
 /// Applies the variant's method switches, and its augmentation (or penalty) parameter as a
 /// multiple `r_factor` of the engine's default r of every contact node.
+/// Every run uses one element thread, so that wall times measure work and not how many
+/// cores happened to be free.
 fn apply(model: &mut Model, v: &Variant) {
+    model.settings.threads = 1;
     model.settings.contact = v.contact;
     model.settings.stepping.line_search = v.line_search;
     model.settings.stepping.anti_cycling = v.anti_cycling;

@@ -98,6 +98,8 @@ fn measure(v: &CupVariant, scratch: &std::path::Path) -> Result<Measured> {
     let mut base = rhai::Map::new();
     // One frame at the start and one at the end: the study needs the summary only.
     base.insert("output_every".into(), Dynamic::from(1_000_000_i64));
+    // One element thread: wall times measure work, not free cores.
+    base.insert("threads".into(), Dynamic::from(1_i64));
     for (k, val) in &v.settings {
         base.insert((*k).into(), val.clone());
     }
