@@ -2,7 +2,8 @@
 //! deformable sheet and rigid curved tools, scripted in Rhai.
 //!
 //! Layers, each knowing only those below it (see DESIGN.md):
-//! `geometry` -> `contact` -> `tool` -> `mesh`/`material`/`element` -> `solver` -> `output` -> `script`.
+//! `geometry` -> `contact` -> `tool` -> `mesh`/`material`/`element` -> `solver` -> `output` -> `script`
+//! -> `study` (families of runs, charted speed against accuracy).
 
 pub mod contact;
 pub mod element;
@@ -13,6 +14,7 @@ pub mod mesh;
 pub mod output;
 pub mod script;
 pub mod solver;
+pub mod study;
 pub mod tool;
 
 pub use error::{Error, Result};

@@ -1,4 +1,4 @@
-//! The `tribo` command line: run a process script, or step it in a REPL.
+//! The `tribo` command line: run a process script, step it in a REPL, or run the studies.
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -35,6 +35,18 @@ enum Command {
         /// or at a stop): the script builds the model again, then the state is loaded.
         #[arg(long, value_name = "CHECKPOINT")]
         restart: Option<PathBuf>,
+    },
+    /// Speed against accuracy: work-precision charts and stability maps with a report.
+    Study {
+        /// hertz, friction_work, cylinder_drag, square_cup, stability, all, or report (only
+        /// rewrite the report from the results in the folder).
+        name: String,
+        /// Output folder (default: out/studies).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// No progress lines.
+        #[arg(long)]
+        quiet: bool,
     },
     /// Interactive stepping; loads SCRIPT's scene first if given.
     Repl {
@@ -76,6 +88,13 @@ fn main() -> ExitCode {
             eprintln!("results in {}", host.out_dir.display());
             Ok(())
         })(),
+        Command::Study { name, out, quiet } => {
+            let out = out.unwrap_or_else(|| PathBuf::from("out/studies"));
+            let command = format!("tribo study {name} --out {}", out.display());
+            let mut opts = tribo::study::StudyOptions::new(out, command);
+            opts.progress = !quiet;
+            tribo::study::run(&name, &opts)
+        }
         Command::Repl { script, out } => {
             let host = HostOptions {
                 out_dir: out.unwrap_or_else(|| default_out(script.as_ref())),

@@ -66,25 +66,18 @@ fn paper_law(measure: WorkMeasure, cut: f64) -> FrictionLaw {
 }
 
 /// Psi(s) of dPsi/ds = mu(Psi) n_node by RK4 with a step far below the test's (error
-/// ~ h^4 ~ 1e-14 relative), sampled at `samples` + 1 equally spaced points.
+/// ~ h^4 ~ 1e-14 relative), sampled at `samples` + 1 equally spaced points (the study's
+/// integrator, on the same law and slide as this test).
 fn ode_reference(n_node: f64, samples: usize) -> Vec<f64> {
-    let law = BernsteinLaw::new(POINTS.to_vec(), WORK_CUT, WorkMeasure::PerNode).unwrap();
-    let f = |psi: f64| law.mu(psi, 1.0) * n_node;
-    let sub = 2000;
-    let h = SLIDE / (samples * sub) as f64;
-    let mut psi = 0.0;
-    let mut out = vec![0.0];
-    for _ in 0..samples {
-        for _ in 0..sub {
-            let k1 = f(psi);
-            let k2 = f(psi + 0.5 * h * k1);
-            let k3 = f(psi + 0.5 * h * k2);
-            let k4 = f(psi + h * k3);
-            psi += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-        }
-        out.push(psi);
-    }
-    out
+    assert_eq!(
+        (POINTS, WORK_CUT, SLIDE),
+        (
+            tribo::study::scenes::ODE_POINTS,
+            tribo::study::scenes::ODE_WORK_CUT,
+            tribo::study::scenes::ODE_SLIDE
+        )
+    );
+    tribo::study::scenes::ode_work(n_node, samples, 2000).unwrap()
 }
 
 /// (error in the final work, largest error of the friction force of an increment against

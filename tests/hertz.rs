@@ -15,9 +15,10 @@ use tribo::mesh::{End, Grading, Mesh};
 use tribo::solver::{Model, Simulation};
 use tribo::tool::schedule::ScalarSchedule;
 
-const E: f64 = 1000.0;
-const NU: f64 = 0.3;
-const R: f64 = 500.0;
+// The study's Hertz scene (`tribo::study::scenes`), whose measure this test uses.
+const E: f64 = tribo::study::scenes::HERTZ_E;
+const NU: f64 = tribo::study::scenes::HERTZ_NU;
+const R: f64 = tribo::study::scenes::HERTZ_R;
 const SIZE: f64 = 40.0;
 const INDENT: f64 = 0.01;
 
@@ -84,62 +85,16 @@ fn hertz_on(cells: usize, bezier: bool) -> (HertzResult, Simulation) {
     let mut sim = Simulation::new(model).unwrap();
     sim.run(|_, _| Ok(())).unwrap();
 
-    // Load per unit length on the full cylinder: twice the half model's, over thickness 1.
-    let p = 2.0 * sim.tool_force(0).z;
-    let e_star = E / (1.0 - NU * NU);
-    let a_exact = (4.0 * p * R / (std::f64::consts::PI * e_star)).sqrt();
-    let p0_exact = 2.0 * p / (std::f64::consts::PI * a_exact);
-
-    // Nodal pressures lambda_n / tributary area along the y = 0 row of the top face.
-    let contact = &sim.model.contacts[0];
-    let mut profile: Vec<(f64, f64, bool)> = contact
-        .candidates
-        .iter()
-        .zip(sim.contact_states(0))
-        .zip(&contact.areas)
-        .filter(|((&n, _), _)| sim.model.mesh.nodes[n].y == 0.0)
-        .map(|((&n, s), &area)| {
-            (
-                sim.model.mesh.nodes[n].x,
-                -s.lambda_n() / area,
-                s.status.is_active(),
-            )
-        })
-        .collect();
-    profile.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let p0_fem = profile[0].1;
-    // Half-width: least-squares fit of the elliptic profile p^2 = p0^2 (1 - x^2/a^2) to the
-    // active nodes, leaving out the outermost one whose tributary strip straddles the edge.
-    let active: Vec<(f64, f64)> = profile
-        .iter()
-        .filter(|q| q.2 && q.1 > 0.0)
-        .map(|q| (q.0, q.1))
-        .collect();
-    assert!(
-        active.len() >= 4,
-        "at least 4 nodes in contact on {cells} cells"
-    );
-    let fit = &active[..active.len() - 1];
-    let (sx, sy, sxx, sxy, m) = fit.iter().fold((0.0, 0.0, 0.0, 0.0, 0.0), |acc, &(x, pr)| {
-        let (u, v) = (x * x, pr * pr);
-        (
-            acc.0 + u,
-            acc.1 + v,
-            acc.2 + u * u,
-            acc.3 + u * v,
-            acc.4 + 1.0,
-        )
-    });
-    let slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
-    let intercept = (sy - slope * sx) / m;
-    let a_fem = (-intercept / slope).sqrt();
+    // Half-width (least-squares fit of the elliptic profile to the nodal pressures) and
+    // peak pressure, with the closed form for the computed load: the study's measure.
+    let m = tribo::study::scenes::hertz_measure(&sim).unwrap();
     let result = HertzResult {
         cells,
         smallest_cell,
-        a_fem,
-        a_exact,
-        p0_fem,
-        p0_exact,
+        a_fem: m.a_fem,
+        a_exact: m.a_exact,
+        p0_fem: m.p0_fem,
+        p0_exact: m.p0_exact,
     };
     (result, sim)
 }

@@ -458,13 +458,18 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     engine.register_fn(
         "simulation",
         move |mesh: Mesh, mat: ScriptMaterial| -> ScriptResult<ScriptSim> {
-            let model = lift(Model::new(mesh, mat.0))?;
+            let mut model = lift(Model::new(mesh, mat.0))?;
+            let mut knobs = Knobs {
+                output_every: 1,
+                checkpoint_every: 0,
+            };
+            apply_settings(&mut model.settings, &mut knobs, &h.base_settings)?;
             Ok(Rc::new(RefCell::new(SimState {
                 model: Some(model),
                 sim: None,
                 output: None,
-                output_every: 1,
-                checkpoint_every: 0,
+                output_every: knobs.output_every,
+                checkpoint_every: knobs.checkpoint_every,
                 host: h.clone(),
                 started: None,
                 wall_time: None,

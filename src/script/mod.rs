@@ -40,6 +40,12 @@ pub struct HostOptions {
     pub restart_used: Rc<std::cell::Cell<bool>>,
     /// Print warnings of converged increments (status cycling, limits exceeded at dt_min).
     pub warnings: bool,
+    /// Settings given to every simulation the script creates, before the script's own
+    /// `sim.settings(...)` calls (same keys): how a study switches the method of a script
+    /// that does not declare the switch itself.
+    pub base_settings: rhai::Map,
+    /// Show the script's `print` output (a study running many scripts turns it off).
+    pub script_print: bool,
 }
 
 impl Default for HostOptions {
@@ -53,6 +59,8 @@ impl Default for HostOptions {
             restart: None,
             restart_used: Rc::default(),
             warnings: true,
+            base_settings: rhai::Map::new(),
+            script_print: true,
         }
     }
 }
@@ -67,6 +75,9 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.set_max_array_size(1 << 22);
     engine.set_max_map_size(1 << 16);
     engine.set_module_resolver(stdlib::resolver(script_dir));
+    if !host.script_print {
+        engine.on_print(|_| {});
+    }
     let host = Rc::new(host.clone());
     api_scene::register(&mut engine, host.clone());
     api_tools::register(&mut engine, script_dir);

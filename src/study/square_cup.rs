@@ -1,0 +1,251 @@
+//! Work-precision of the NUMISHEET'93 square cup (paper variant), run through
+//! `scripts/square_cup.rhai` itself with `--set`-style overrides (cells, layers, step,
+//! travel, r_contact) and, for the method switches the script does not declare, settings
+//! given to its simulation before the script's own (`HostOptions::base_settings`).
+//!
+//! The travel is cut to 15 mm (the first travel at which the script records the draw-in)
+//! to keep the study cheap. Error against the reference run (25 x 25 x 1 cells, 0.25 mm
+//! increments):
+//!
+//! ```text
+//! e = max(|DX - DX_ref| / DX_ref, |DD - DD_ref| / DD_ref, |F - F_ref| / F_ref)
+//! ```
+//!
+//! with DX the inward travel of the blank's edge midpoint, DD that of its corner along the
+//! diagonal, and F the punch force at 15 mm (its peak so far, full cup).
+
+use super::work_precision::{run_families, write_case, CaseResult, Family, Labelled, Measured};
+use super::{Cost, StudyOptions};
+use crate::script::{self, HostOptions};
+use crate::{Error, Result};
+use rhai::Dynamic;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Punch travel of every run [mm].
+pub const TRAVEL: f64 = 15.0;
+
+/// One square-cup run: the script's own parameters and extra solver settings.
+#[derive(Clone, Debug)]
+pub struct CupVariant {
+    pub label: String,
+    pub cells: i64,
+    pub layers: i64,
+    /// Nominal increment of punch travel [mm].
+    pub step: f64,
+    /// The script's `r_contact` (< 0: E t, 0: the engine's default per node).
+    pub r_contact: f64,
+    /// Settings given before the script's own, e.g. ("friction_update", "implicit").
+    pub settings: Vec<(&'static str, Dynamic)>,
+}
+
+impl Labelled for CupVariant {
+    fn label(&self) -> &str {
+        &self.label
+    }
+}
+
+impl CupVariant {
+    pub fn new(label: impl Into<String>, cells: i64, step: f64) -> Self {
+        CupVariant {
+            label: label.into(),
+            cells,
+            layers: 1,
+            step,
+            r_contact: -1.0,
+            settings: Vec::new(),
+        }
+    }
+
+    fn with(&self, label: &str, change: impl FnOnce(&mut CupVariant)) -> Self {
+        let mut v = self.clone();
+        v.label = label.into();
+        change(&mut v);
+        v
+    }
+}
+
+/// The script: `scripts/square_cup.rhai` under the working directory, else in the source
+/// tree this binary was built from.
+fn script_path() -> Result<PathBuf> {
+    let local = PathBuf::from("scripts/square_cup.rhai");
+    if local.is_file() {
+        return Ok(local);
+    }
+    let built = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scripts/square_cup.rhai");
+    if built.is_file() {
+        return Ok(built);
+    }
+    Err(Error::Input(format!(
+        "the square-cup study needs scripts/square_cup.rhai (looked in the working directory and in {})",
+        env!("CARGO_MANIFEST_DIR")
+    )))
+}
+
+/// Runs the script into a scratch folder under `scratch` and reads its summary.json.
+fn measure(v: &CupVariant, scratch: &std::path::Path) -> Result<Measured> {
+    let path = script_path()?;
+    let out = scratch.join(v.label.replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
+    let _ = std::fs::remove_dir_all(&out);
+    let overrides = vec![
+        ("cells".to_string(), Dynamic::from(v.cells)),
+        ("layers".to_string(), Dynamic::from(v.layers)),
+        ("step".to_string(), Dynamic::from(v.step)),
+        ("travel".to_string(), Dynamic::from(TRAVEL)),
+        ("r_contact".to_string(), Dynamic::from(v.r_contact)),
+        ("charts".to_string(), Dynamic::from(false)),
+    ];
+    let mut base = rhai::Map::new();
+    // One frame at the start and one at the end: the study needs the summary only.
+    base.insert("output_every".into(), Dynamic::from(1_000_000_i64));
+    // One element thread: wall times measure work, not free cores.
+    base.insert("threads".into(), Dynamic::from(1_i64));
+    for (k, val) in &v.settings {
+        base.insert((*k).into(), val.clone());
+    }
+    let host = HostOptions {
+        out_dir: out.clone(),
+        progress: false,
+        warnings: false,
+        base_settings: base,
+        script_print: false,
+        ..HostOptions::default()
+    };
+    let run = script::run_file(&path, &overrides, &host);
+    let summary_path = out.join(crate::output::SUMMARY_FILE);
+    let summary: Option<serde_json::Value> = std::fs::read_to_string(&summary_path)
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let _ = std::fs::remove_dir_all(&out);
+    run?;
+    let s = summary.ok_or_else(|| Error::io(&summary_path, "no readable summary after the run"))?;
+    let num = |v: &serde_json::Value, what: &str| {
+        v.as_f64().ok_or_else(|| {
+            Error::Input(format!(
+                "square cup summary: '{what}' missing or not a number"
+            ))
+        })
+    };
+    if s["status"] != "finished" {
+        return Err(Error::NoConvergence(format!(
+            "square cup stopped: {}",
+            s["error"].as_str().unwrap_or("no reason given")
+        )));
+    }
+    let draw = &s["draw_in"][0];
+    let cost = Cost {
+        wall_s: 0.0,
+        iterations: num(&s["newton_iterations"], "newton_iterations")? as usize,
+        increments: num(&s["increments"], "increments")? as usize,
+        cutbacks: num(&s["cutbacks"], "cutbacks")? as usize,
+    };
+    let mut values = BTreeMap::new();
+    values.insert("draw_in_dx_mm".into(), num(&draw["dx"], "draw_in dx")?);
+    values.insert("draw_in_dd_mm".into(), num(&draw["dd"], "draw_in dd")?);
+    values.insert(
+        "punch_force_n".into(),
+        num(&s["punch_force_peak_n"], "punch_force_peak_n")?,
+    );
+    Ok((cost, values))
+}
+
+/// Largest relative difference of DX, DD and the punch force from the reference's.
+pub fn error(m: &BTreeMap<String, f64>, r: Option<&BTreeMap<String, f64>>) -> f64 {
+    let r = r.expect("the square cup is measured against its reference run");
+    ["draw_in_dx_mm", "draw_in_dd_mm", "punch_force_n"]
+        .iter()
+        .map(|k| {
+            let (a, b) = (m[*k], r[*k]);
+            (a - b).abs() / b.abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+fn families() -> Vec<Family<CupVariant>> {
+    let s = |v: &str| Dynamic::from(v.to_string());
+    let base = CupVariant::new("16 cells", 16, 0.5);
+    let fine = CupVariant::new("25 cells", 25, 0.5);
+    vec![
+        Family {
+            name: "mesh (0.5 mm steps)",
+            variants: [8, 12, 16, 20, 25]
+                .map(|c| CupVariant::new(format!("{c}x{c}"), c, 0.5))
+                .to_vec(),
+        },
+        Family {
+            name: "step (25 x 25)",
+            variants: [3.0, 1.5, 1.0]
+                .map(|st| CupVariant::new(format!("{st} mm"), 25, st))
+                .to_vec(),
+        },
+        Family {
+            name: "layers (12 x 12, 0.5 mm)",
+            variants: [1, 2, 4]
+                .map(|l| {
+                    let mut v = CupVariant::new(format!("{l} layer(s)"), 12, 0.5);
+                    v.layers = l;
+                    v
+                })
+                .to_vec(),
+        },
+        Family {
+            name: "methods (16 x 16, 0.5 mm)",
+            variants: vec![
+                base.with("implicit friction", |v| {
+                    v.settings.push(("friction_update", s("implicit")))
+                }),
+                base.with("curvature off", |v| {
+                    v.settings.push(("curvature", Dynamic::from(false)))
+                }),
+                base.with("frame frozen", |v| v.settings.push(("frame", s("frozen")))),
+                base.with("AL r = engine default", |v| v.r_contact = 0.0),
+                base.with("AL r = 10 E t", |v| v.r_contact = 10.0 * E_T),
+                base.with("penalty r = E t", |v| {
+                    v.settings.push(("enforcement", s("penalty")))
+                }),
+                base.with("penalty r = 10 E t", |v| {
+                    v.r_contact = 10.0 * E_T;
+                    v.settings.push(("enforcement", s("penalty")))
+                }),
+            ],
+        },
+        // On the reference's mesh, where the error is the method's own (and the step's).
+        Family {
+            name: "methods (25 x 25, 0.5 mm)",
+            variants: vec![
+                fine.with("25: implicit friction", |v| {
+                    v.settings.push(("friction_update", s("implicit")))
+                }),
+                fine.with("25: frame frozen", |v| {
+                    v.settings.push(("frame", s("frozen")))
+                }),
+                fine.with("25: penalty r = E t", |v| {
+                    v.settings.push(("enforcement", s("penalty")))
+                }),
+            ],
+        },
+    ]
+}
+
+/// E t of the script's aluminium blank (71 GPa x 0.81 mm), N/mm: its default r.
+const E_T: f64 = 71_000.0 * 0.81;
+
+pub fn run(opts: &StudyOptions) -> Result<()> {
+    let dir = opts.folder("square_cup")?;
+    let scratch = dir.join("scratch");
+    let measure = |v: &CupVariant| measure(v, &scratch);
+    let reference = CupVariant::new("reference: 25x25, 0.25 mm", 25, 0.25);
+    let (reference, points) =
+        run_families(&families(), Some(&reference), &measure, &error, Some(opts))?;
+    let _ = std::fs::remove_dir_all(&scratch);
+    let result = CaseResult {
+        name: "square_cup".into(),
+        title: format!("NUMISHEET'93 square cup, paper variant, punch to {TRAVEL} mm"),
+        error_measure: "max(|DX - DX_ref| / DX_ref, |DD - DD_ref| / DD_ref, |F - F_ref| / F_ref): draw-in of the edge midpoint and of the corner, punch force at 15 mm, against the reference run (25 x 25 x 1, 0.25 mm increments)".into(),
+        reference,
+        notes: "The reference has the finest mesh of the study (25 x 25 x 1), so the errors measure the distance to that run, not to the converged solution: the 25 x 25 runs show only their step error, and a run within 1 % here is within 1 % of a 25 x 25 solution. The layers family is measured against a one-layer reference: its error includes the change of the through-thickness model itself. The 16 x 16 methods family compares costs; its mesh error (the mesh family's 16 x 16 point) dominates its errors: compare each method's values with that point (in the CSV); switches that change only the Newton path (r of the augmented Lagrangian, curvature terms) give the same result on the same mesh. The 25 x 25 methods family runs on the reference's mesh: its errors are the methods' own plus the 0.5 mm step's (the mesh family's 25 x 25 point).".into(),
+        points,
+        command: opts.command.clone(),
+    };
+    write_case(&result, opts)
+}
