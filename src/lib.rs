@@ -5,6 +5,13 @@
 //! `geometry` -> `contact` -> `tool` -> `mesh`/`material`/`element` -> `solver` -> `output` -> `script`
 //! -> `study` (families of runs, charted speed against accuracy).
 
+// `!(x > 0.0)` is how inputs are refused when they are not positive *or are NaN*; the
+// `partial_cmp` spelling clippy suggests hides that intent.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Index loops over several arrays of the same element (nodes, components, Gauss points)
+// read like the formulas they implement.
+#![allow(clippy::needless_range_loop)]
+
 pub mod contact;
 pub mod element;
 pub mod error;

@@ -48,9 +48,7 @@ fn check(mut model: tribo::solver::Model) -> Simulation {
     let e = sim.evaluate_at(t_new, &x).unwrap();
     let statuses: Vec<_> = e.nodal[0].iter().map(|(r, _)| r.status).collect();
     assert!(
-        statuses
-            .iter()
-            .any(|s| *s == tribo::contact::ContactStatus::Slip),
+        statuses.contains(&tribo::contact::ContactStatus::Slip),
         "some node slips"
     );
 
