@@ -65,12 +65,13 @@ const VIRIDIS: [[u8; 3]; 9] = [
 ];
 
 /// Colours of the series, in order (matplotlib's tab10, cycled).
-const PALETTE: [&str; 10] = [
+pub(crate) const PALETTE: [&str; 10] = [
     "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
     "#bcbd22", "#17becf",
 ];
 
-const FONT: &str = "font-family=\"Helvetica, Arial, sans-serif\"";
+/// Font of every chart, set once on the `<svg>` element.
+pub(crate) const FONT: &str = "font-family=\"Helvetica, Arial, sans-serif\"";
 /// Colour of a node without a value.
 const NO_VALUE: &str = "#bdbdbd";
 const MAX_POLYGONS: usize = 20_000;
@@ -182,7 +183,16 @@ fn svg_open(out: &mut String, width: f64, height: f64) {
     );
 }
 
-fn text(out: &mut String, x: f64, y: f64, size: f64, anchor: &str, extra: &str, s: &str) {
+/// A `<text>` element; `extra` holds further attributes, each with a leading space.
+pub(crate) fn text(
+    out: &mut String,
+    x: f64,
+    y: f64,
+    size: f64,
+    anchor: &str,
+    extra: &str,
+    s: &str,
+) {
     let _ = writeln!(
         out,
         "<text x=\"{}\" y=\"{}\" font-size=\"{size}\" text-anchor=\"{anchor}\"{extra}>{}</text>",

@@ -9,7 +9,7 @@
 //! in the CSV).
 
 use super::Outcome;
-use crate::output::xml_escape;
+use crate::output::svg::{text, FONT, PALETTE};
 use std::fmt::Write as _;
 
 /// One family of a work-precision chart: (x, y, label) points in the order to join them.
@@ -17,12 +17,6 @@ pub struct LogSeries {
     pub name: String,
     pub points: Vec<(f64, f64, String)>,
 }
-
-const PALETTE: [&str; 10] = [
-    "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
-    "#bcbd22", "#17becf",
-];
-const FONT: &str = "font-family=\"Helvetica, Arial, sans-serif\"";
 
 fn decade_label(k: i32) -> String {
     match k {
@@ -73,17 +67,33 @@ pub fn log_log(
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" viewBox=\"0 0 {width} {height}\">"
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" viewBox=\"0 0 {width} {height}\" {FONT}>"
     );
     let _ = writeln!(o, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
-    text(&mut o, (left + right) / 2.0, 28.0, 16.0, "middle", title);
+    text(
+        &mut o,
+        (left + right) / 2.0,
+        28.0,
+        16.0,
+        "middle",
+        "",
+        title,
+    );
     for k in x0..=x1 {
         let x = sx(10f64.powi(k));
         let _ = writeln!(
             o,
             "<line x1=\"{x:.1}\" y1=\"{top}\" x2=\"{x:.1}\" y2=\"{bottom}\" stroke=\"#dddddd\"/>"
         );
-        text(&mut o, x, bottom + 18.0, 12.0, "middle", &decade_label(k));
+        text(
+            &mut o,
+            x,
+            bottom + 18.0,
+            12.0,
+            "middle",
+            "",
+            &decade_label(k),
+        );
     }
     for k in y0..=y1 {
         let y = sy(10f64.powi(k));
@@ -91,7 +101,15 @@ pub fn log_log(
             o,
             "<line x1=\"{left}\" y1=\"{y:.1}\" x2=\"{right}\" y2=\"{y:.1}\" stroke=\"#dddddd\"/>"
         );
-        text(&mut o, left - 6.0, y + 4.0, 12.0, "end", &decade_label(k));
+        text(
+            &mut o,
+            left - 6.0,
+            y + 4.0,
+            12.0,
+            "end",
+            "",
+            &decade_label(k),
+        );
     }
     let _ = writeln!(
         o,
@@ -105,19 +123,16 @@ pub fn log_log(
         bottom + 42.0,
         13.0,
         "middle",
+        "",
         x_label,
     );
-    let _ = writeln!(
-        o,
-        "<text x=\"20\" y=\"{:.1}\" font-size=\"13\" {FONT} text-anchor=\"middle\" transform=\"rotate(-90 20 {:.1})\">{}</text>",
-        (top + bottom) / 2.0,
-        (top + bottom) / 2.0,
-        xml_escape(y_label)
-    );
+    let yc = (top + bottom) / 2.0;
+    let turn = format!(" transform=\"rotate(-90 20 {yc:.1})\"");
+    text(&mut o, 20.0, yc, 13.0, "middle", &turn, y_label);
     if let Some((v, label)) = hline {
         let y = sy(v);
         let _ = writeln!(o, "<line x1=\"{left}\" y1=\"{y:.1}\" x2=\"{right}\" y2=\"{y:.1}\" stroke=\"#555555\" stroke-dasharray=\"6 4\"/>");
-        text(&mut o, right - 4.0, y - 5.0, 11.0, "end", label);
+        text(&mut o, right - 4.0, y - 5.0, 11.0, "end", "", label);
     }
     for (i, s) in series.iter().enumerate() {
         let colour = PALETTE[i % PALETTE.len()];
@@ -142,22 +157,14 @@ pub fn log_log(
             // Labels alternate above and below their points: runs of one family often
             // share an error and sit side by side.
             let dy = if k % 2 == 0 { -5.0 } else { 13.0 };
-            text(&mut o, x + 5.0, y + dy, 9.0, "start", &p.2);
+            text(&mut o, x + 5.0, y + dy, 9.0, "start", "", &p.2);
         }
         let ly = top + 10.0 + 18.0 * i as f64;
         let _ = writeln!(o, "<line x1=\"{}\" y1=\"{ly:.1}\" x2=\"{}\" y2=\"{ly:.1}\" stroke=\"{colour}\" stroke-width=\"3\"/>", right + 14.0, right + 34.0);
-        text(&mut o, right + 40.0, ly + 4.0, 12.0, "start", &s.name);
+        text(&mut o, right + 40.0, ly + 4.0, 12.0, "start", "", &s.name);
     }
     o.push_str("</svg>\n");
     o
-}
-
-fn text(o: &mut String, x: f64, y: f64, size: f64, anchor: &str, s: &str) {
-    let _ = writeln!(
-        o,
-        "<text x=\"{x:.1}\" y=\"{y:.1}\" font-size=\"{size}\" {FONT} text-anchor=\"{anchor}\">{}</text>",
-        xml_escape(s)
-    );
 }
 
 /// One panel of an outcome grid: `cells[row][col]` = (outcome, text shown in the cell).
@@ -209,10 +216,10 @@ pub fn outcome_grid(
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}\" height=\"{height:.0}\" viewBox=\"0 0 {width:.0} {height:.0}\">"
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}\" height=\"{height:.0}\" viewBox=\"0 0 {width:.0} {height:.0}\" {FONT}>"
     );
     let _ = writeln!(o, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
-    text(&mut o, width / 2.0, 26.0, 16.0, "middle", title);
+    text(&mut o, width / 2.0, 26.0, 16.0, "middle", "", title);
     for (i, p) in panels.iter().enumerate() {
         let ox = 20.0 + (i % per_row) as f64 * panel_w;
         let oy = 50.0 + (i / per_row) as f64 * panel_h;
@@ -224,6 +231,7 @@ pub fn outcome_grid(
                 oy + 14.0 + 16.0 * k as f64,
                 13.0,
                 "middle",
+                "",
                 line,
             );
         }
@@ -235,6 +243,7 @@ pub fn outcome_grid(
                 y + cell_h / 2.0 + 4.0,
                 11.0,
                 "end",
+                "",
                 &p.rows[r],
             );
             for (c, (outcome, label)) in row.iter().enumerate() {
@@ -252,6 +261,7 @@ pub fn outcome_grid(
                     y + cell_h / 2.0 + 4.0,
                     11.0,
                     "middle",
+                    "",
                     label,
                 );
             }
@@ -264,6 +274,7 @@ pub fn outcome_grid(
                 yb + 14.0,
                 11.0,
                 "middle",
+                "",
                 label,
             );
         }
@@ -273,17 +284,12 @@ pub fn outcome_grid(
             yb + 30.0,
             11.0,
             "middle",
+            "",
             col_label,
         );
-        let _ = writeln!(
-            o,
-            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" {FONT} text-anchor=\"middle\" transform=\"rotate(-90 {:.1} {:.1})\">{}</text>",
-            ox + 10.0,
-            oy + pad_t + p.rows.len() as f64 * cell_h / 2.0,
-            ox + 10.0,
-            oy + pad_t + p.rows.len() as f64 * cell_h / 2.0,
-            xml_escape(row_label)
-        );
+        let (rx, ry) = (ox + 10.0, oy + pad_t + p.rows.len() as f64 * cell_h / 2.0);
+        let turn = format!(" transform=\"rotate(-90 {rx:.1} {ry:.1})\"");
+        text(&mut o, rx, ry, 11.0, "middle", &turn, row_label);
     }
     let ly = height - 40.0;
     let all = [
@@ -301,7 +307,7 @@ pub fn outcome_grid(
             ly - 11.0,
             outcome_colour(outcome)
         );
-        text(&mut o, x + 18.0, ly, 11.0, "start", outcome.name());
+        text(&mut o, x + 18.0, ly, 11.0, "start", "", outcome.name());
         x += 24.0 + 6.5 * outcome.name().len() as f64;
     }
     text(
@@ -310,6 +316,7 @@ pub fn outcome_grid(
         ly + 20.0,
         11.0,
         "start",
+        "",
         "number: Newton iterations of the whole run; iN: the run failed in increment N",
     );
     o.push_str("</svg>\n");
