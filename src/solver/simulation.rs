@@ -84,9 +84,6 @@ struct Trial {
     times: PhaseTimes,
     cycling: Vec<CyclingNode>,
     line_search_cuts: usize,
-    /// Residual of the free contact law at the converged state (differs from the last
-    /// residual only when some status was frozen).
-    unfrozen: IterationRecord,
 }
 
 /// Failures after which a smaller increment may succeed.
@@ -527,13 +524,14 @@ impl Simulation {
                 nodes.len(),
                 nodes[..nodes.len().min(SHOWN)].join(", "),
                 if more > 0 { format!(" and {more} more") } else { String::new() },
-                if frozen {
-                    format!(
+                // Frozen statuses are always released before an increment is accepted, so
+                // the last residual is the free law's.
+                match report.residuals.last().filter(|_| frozen) {
+                    Some(free) => format!(
                         "; free-law residual at the converged state: force {:.3e} relative, contact {:.3e}",
-                        trial.unfrozen.force_rel, trial.unfrozen.contact
-                    )
-                } else {
-                    String::new()
+                        free.force_rel, free.contact
+                    ),
+                    None => String::new(),
                 }
             ));
         }
@@ -744,8 +742,10 @@ impl Simulation {
                 || rec.force <= settings.force_abs_tol;
             if force_ok && rec.contact <= settings.contact_tol {
                 // Converged with frozen statuses: only the free law's solution counts, so
-                // Newton goes on unfrozen from this state, near the solution.
-                if ctx.forced.is_some() && releases < MAX_RELEASES {
+                // Newton goes on unfrozen from this state, near the solution. After the
+                // last allowed release nothing is frozen again, so no frozen state is
+                // ever accepted.
+                if ctx.forced.is_some() {
                     releases += 1;
                     monitor.release(releases < MAX_RELEASES);
                     ctx.forced = None;
@@ -810,13 +810,6 @@ impl Simulation {
             eval = eval_new;
             iterations += 1;
         }
-        let unfrozen = if ctx.forced.is_some() {
-            ctx.forced = None;
-            let free = ctx.evaluate(&x, &mut times)?;
-            self.residual_record(&free, &weights).0
-        } else {
-            residuals[residuals.len() - 1]
-        };
         Ok(Trial {
             x,
             eval,
@@ -825,7 +818,6 @@ impl Simulation {
             times,
             cycling: monitor.report(node_of),
             line_search_cuts,
-            unfrozen,
         })
     }
 
