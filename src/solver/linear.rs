@@ -219,39 +219,39 @@ impl BorderedSystem {
                 next += 1;
             }
         }
-        let mut slots = Vec::with_capacity(full.nnz());
-        let mut inner_entries = Vec::new();
-        for col in 0..n {
-            for &row in &full.row_idx[full.col_ptr[col]..full.col_ptr[col + 1]] {
-                let slot = match (inner_index[row], inner_index[col]) {
-                    (Some(r), Some(c)) => {
-                        inner_entries.push((r, c));
-                        Slot::A(0)
-                    }
-                    (Some(r), None) => Slot::B {
-                        row: r,
-                        col: border_index[col].expect("a border unknown"),
-                    },
-                    (None, Some(c)) => Slot::C {
-                        row: border_index[row].expect("a border unknown"),
-                        col: c,
-                    },
-                    (None, None) => Slot::D {
-                        row: border_index[row].expect("a border unknown"),
-                        col: border_index[col].expect("a border unknown"),
-                    },
-                };
-                slots.push(slot);
-            }
-        }
-        let inner_pattern = Arc::new(SparsePattern::from_entries(next, inner_entries));
-        for (k, slot) in slots.iter_mut().enumerate() {
-            if let Slot::A(_) = slot {
-                let (row, col) = full_entry(full, k);
-                let (r, c) = (inner_index[row].unwrap(), inner_index[col].unwrap());
-                *slot = Slot::A(inner_pattern.position(r, c).expect("entry collected above"));
-            }
-        }
+        // Entries of the full pattern in storage order (column by column), as (row, col).
+        let entries = || {
+            (0..n).flat_map(move |col| {
+                full.row_idx[full.col_ptr[col]..full.col_ptr[col + 1]]
+                    .iter()
+                    .map(move |&row| (row, col))
+            })
+        };
+        let inner_pattern = Arc::new(SparsePattern::from_entries(
+            next,
+            entries().filter_map(|(row, col)| Some((inner_index[row]?, inner_index[col]?))),
+        ));
+        let slots = entries()
+            .map(|(row, col)| match (inner_index[row], inner_index[col]) {
+                (Some(r), Some(c)) => Slot::A(
+                    inner_pattern
+                        .position(r, c)
+                        .expect("entry of the inner pattern"),
+                ),
+                (Some(r), None) => Slot::B {
+                    row: r,
+                    col: border_index[col].expect("a border unknown"),
+                },
+                (None, Some(c)) => Slot::C {
+                    row: border_index[row].expect("a border unknown"),
+                    col: c,
+                },
+                (None, None) => Slot::D {
+                    row: border_index[row].expect("a border unknown"),
+                    col: border_index[col].expect("a border unknown"),
+                },
+            })
+            .collect();
         Ok(BorderedSystem {
             full: full.clone(),
             border: border.to_vec(),
@@ -313,12 +313,6 @@ impl BorderedSystem {
         }
         Ok(())
     }
-}
-
-/// (row, col) of the k-th stored entry of a column-major pattern.
-fn full_entry(p: &SparsePattern, k: usize) -> (usize, usize) {
-    let col = p.col_ptr.partition_point(|&start| start <= k) - 1;
-    (p.row_idx[k], col)
 }
 
 #[cfg(test)]
