@@ -13,7 +13,8 @@
 //! The isochoric part of `F` is kept at each of the 2x2x2 Gauss points; the volume change
 //! is the centre's, one volumetric constraint per element, so nearly incompressible
 //! (plastic) flow does not lock. The material sees `F̄` only
-//! ([`Material::update_finite`]: second Piola-Kirchhoff `S̄` and `ℂ = ∂S̄/∂Ē_GL`).
+//! ([`Material::update_finite_displacement_gradient`], given `F̄ - I` formed without
+//! round-off from `I`: second Piola-Kirchhoff `S̄` and `ℂ = ∂S̄/∂Ē_GL`).
 //!
 //! # Weak form (variationally consistent F-bar)
 //!
@@ -74,9 +75,18 @@ impl Default for Hex8FBar {
     }
 }
 
-/// `F = I + Σ u_a ⊗ b_a`.
-fn gradient(u: &[Vec3; NODES], b: &[Vec3; NODES]) -> Mat3 {
-    (0..NODES).fold(Mat3::identity(), |f, a| f + u[a] * b[a].transpose())
+/// The displacement gradient `H = Σ u_a ⊗ b_a` (`F = I + H`). Kept apart from `F`:
+/// strains of `10⁻⁶` (a stiff sheet in bending) would keep only ~10 digits in `I + H`,
+/// and the material forms its strain from `H` (see `material::log_strain`).
+fn displacement_gradient(u: &[Vec3; NODES], b: &[Vec3; NODES]) -> Mat3 {
+    (0..NODES).fold(Mat3::zeros(), |h, a| h + u[a] * b[a].transpose())
+}
+
+/// `ln det(I + h)` from `det(I + h) - 1 = tr h + ½((tr h)² - tr h²) + det h`, to the
+/// relative precision of `h` (no cancellation against 1). `det(I + h) > 0` is the caller's.
+fn ln_det_one_plus(h: &Mat3) -> f64 {
+    let tr = h.trace();
+    (tr + 0.5 * (tr * tr - (h * h).trace()) + h.determinant()).ln_1p()
 }
 
 /// Inverse-transpose of a deformation gradient with a positive determinant.
@@ -128,27 +138,34 @@ impl Element<DOFS> for Hex8FBar {
     ) -> Result<ElementResponse<DOFS>> {
         let (x, u, geo) = checked_inputs(ref_coords, u, committed, trial)?;
         let b0 = centre_gradients(&x)?;
-        let (f0_inv_t, j0) = inverse_transpose(&gradient(&u, &b0), "the element centre")?;
+        let h0 = displacement_gradient(&u, &b0);
+        let (f0_inv_t, _) = inverse_transpose(&(Mat3::identity() + h0), "the element centre")?;
+        let ln_j0 = ln_det_one_plus(&h0);
         let g0: [Vec3; NODES] = std::array::from_fn(|a| f0_inv_t * b0[a]);
 
         let mut force = SVector::<f64, DOFS>::zeros();
         let mut stiffness = SMatrix::<f64, DOFS, DOFS>::zeros();
         for gp in 0..POINTS {
             let b = &geo.grad[gp];
-            let f = gradient(&u, b);
-            let (f_inv_t, j) = inverse_transpose(&f, &format!("integration point {gp}"))?;
+            let h = displacement_gradient(&u, b);
+            let f = Mat3::identity() + h;
+            let (f_inv_t, _) = inverse_transpose(&f, &format!("integration point {gp}"))?;
             let g: [Vec3; NODES] = std::array::from_fn(|a| f_inv_t * b[a]);
-            let (r, q) = if self.fbar {
+            // r - 1 = expm1(⅓ ln(J₀/J)), kept to the precision of the strains.
+            let (r_minus_one, q) = if self.fbar {
                 let q = SVector::<f64, DOFS>::from_fn(|i, _| {
                     (g0[i / 3][i % 3] - g[i / 3][i % 3]) / 3.0
                 });
-                ((j0 / j).cbrt(), q)
+                (((ln_j0 - ln_det_one_plus(&h)) / 3.0).exp_m1(), q)
             } else {
-                (1.0, SVector::<f64, DOFS>::zeros())
+                (0.0, SVector::<f64, DOFS>::zeros())
             };
+            let r = 1.0 + r_minus_one;
             let fb = f * r;
+            // F̄ - I = (r - 1) I + r H.
+            let hb = Mat3::identity() * r_minus_one + h * r;
             let resp = material
-                .update_finite(&fb, &committed[gp], &mut trial[gp])
+                .update_finite_displacement_gradient(&hb, &committed[gp], &mut trial[gp])
                 .map_err(|e| prefix(e, &format!("integration point {gp}")))?;
             let s = stress_to_tensor(&resp.pk2);
             let p = fb * s;

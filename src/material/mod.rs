@@ -176,7 +176,21 @@ pub trait Material: std::fmt::Debug + Send + Sync {
         committed: &PointState,
         trial: &mut PointState,
     ) -> Result<FiniteResponse> {
-        log_strain::lagrangian_update(self, f, committed, trial)
+        self.update_finite_displacement_gradient(&(f - Mat3::identity()), committed, trial)
+    }
+
+    /// [`update_finite`](Self::update_finite) at `F = I + h`, given by the displacement
+    /// gradient `h`: what elements call, because `F` itself stores a strain of `10⁻⁶` to
+    /// only ~10 digits (round-off of `I`), too few for the force residual of a stiff,
+    /// thin body (see [`log_strain`]). A material that overrides one of the two
+    /// overrides both.
+    fn update_finite_displacement_gradient(
+        &self,
+        h: &Mat3,
+        committed: &PointState,
+        trial: &mut PointState,
+    ) -> Result<FiniteResponse> {
+        log_strain::lagrangian_update(self, h, committed, trial)
     }
 
     /// The elastic tangent (initial stiffness), e.g. for a first predictor or a
