@@ -14,7 +14,8 @@
 //! `float_roundtrip` parser, so every f64 is restored bit for bit and a restarted run
 //! repeats the uninterrupted one exactly.
 
-use super::simulation::{EnergyBalance, EnergyMemory, IncrementReport, Simulation};
+use super::energy::{EnergyBalance, EnergyMemory};
+use super::simulation::{IncrementReport, Simulation};
 use super::step_control::StepController;
 use crate::contact::ContactNodeState;
 use crate::material::PointState;
