@@ -95,7 +95,7 @@ impl Default for SolverSettings {
             kinematics: crate::element::StrainTheory::Small,
             fbar: true,
             stepping: Default::default(),
-            extrapolate: false,
+            extrapolate: true,
             threads: 0,
         }
     }
@@ -196,10 +196,10 @@ impl Model {
         let areas = self.mesh.tributary_areas(&candidates)?;
         let r = match r {
             Some(r) => vec![r; candidates.len()],
-            // The stiffness of the column of material under each node (see `augmentation`).
+            // The membrane stiffness of the layer under each node (see `augmentation`).
             None => super::augmentation::default_r(
                 &self.mesh,
-                self.material.elastic_tangent()[(0, 0)],
+                super::augmentation::young_modulus(&self.material.elastic_tangent()),
                 &candidates,
             )?,
         };
