@@ -127,6 +127,8 @@ pub struct Simulation {
     /// Last converged increment (dt, change of the displacements), for the extrapolating
     /// predictor.
     last_step: Option<(f64, Vec<f64>)>,
+    /// Stop request polled between Newton iterations (see `crate::interrupt`).
+    interrupt: crate::interrupt::Interrupt,
 }
 
 impl Simulation {
@@ -207,6 +209,7 @@ impl Simulation {
                 ..Default::default()
             },
             last_step: None,
+            interrupt: crate::interrupt::Interrupt::new(),
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -349,6 +352,7 @@ impl Simulation {
     /// to `max_cutbacks` times (the sub-increments are all in `history`). Adaptive stepping:
     /// one increment of the size the controller chose (see `step_control`).
     pub fn step(&mut self) -> Result<IncrementReport> {
+        self.check_interrupt()?;
         if self.is_finished() {
             return Err(Error::Input(format!(
                 "the simulation already reached its end time {}",
@@ -359,6 +363,24 @@ impl Simulation {
             StepMode::Fixed => self.step_fixed(),
             StepMode::Adaptive => self.step_adaptive(),
         }
+    }
+
+    /// Connects a stop request: a raised flag abandons the increment under way at its next
+    /// Newton iteration (`Error::Interrupted`); the committed state stays the last
+    /// converged one.
+    pub fn set_interrupt(&mut self, interrupt: crate::interrupt::Interrupt) {
+        self.interrupt = interrupt;
+    }
+
+    fn check_interrupt(&self) -> Result<()> {
+        if self.interrupt.is_raised() {
+            return Err(Error::Interrupted(format!(
+                "{}; the increment from t = {} was abandoned",
+                self.interrupt.reason(),
+                self.time
+            )));
+        }
+        Ok(())
     }
 
     fn step_fixed(&mut self) -> Result<IncrementReport> {
@@ -382,6 +404,7 @@ impl Simulation {
                     }
                     return Ok(report);
                 }
+                Err(err @ Error::Interrupted(_)) => return Err(err),
                 Err(err) if retryable(&err) && cutbacks < self.model.settings.max_cutbacks => {
                     cutbacks += 1;
                     dt *= 0.5;
@@ -444,6 +467,7 @@ impl Simulation {
                     self.history.push(report.clone());
                     return Ok(report);
                 }
+                Err(err @ Error::Interrupted(_)) => return Err(err),
                 Err(err) if retryable(&err) && dt_used > dt_min * (1.0 + 1e-9) => {
                     cutbacks += 1;
                     dt = (0.5 * dt_used).max(dt_min);
@@ -714,6 +738,7 @@ impl Simulation {
         let mut window_start = 0;
         let mut releases = 0;
         loop {
+            self.check_interrupt()?;
             if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
                 ctx.forced = monitor.forced();
                 eval = ctx.evaluate(&x, &mut times)?;
@@ -950,6 +975,7 @@ impl Simulation {
     ) -> IncrementReport {
         let mut tool_forces = Vec::new();
         let mut dissipated = vec![0.0; self.model.contacts.len()];
+        let mut normal_work = vec![0.0; self.model.contacts.len()];
         let (mut active, mut slipping) = (0, 0);
         for (c, contact) in self.model.contacts.iter().enumerate() {
             let pose = force_control::pose(&self.model, &self.dofs, c, t_new, &x);
@@ -962,8 +988,15 @@ impl Simulation {
                     + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
                 // Work of the contact force on the relative motion, by the trapezoidal rule
                 // like every other work term (Psi below follows the paper instead).
+                // Of it, friction dissipates lambda_t . delta_t (exactly 0 for mu = 0); the
+                // rest is the normal force's work on the relative motion, zero for the exact
+                // solution, which the trapezoidal rule picks up where a gap closes within
+                // the increment (and penalty penetration stores).
                 let relative_motion = xn - pose.to_global_point(&s.x_ref_local);
-                dissipated[c] += 0.5 * (s.lambda + res.f_equi).dot(&relative_motion);
+                let interface = 0.5 * (s.lambda + res.f_equi).dot(&relative_motion);
+                let friction = res.tangential_force.dot(&res.slip_increment);
+                dissipated[c] += friction;
+                normal_work[c] += interface - friction;
                 // The converged force on the tool is F_equi (= lambda for the mixed method).
                 s.lambda = res.f_equi;
                 s.status = res.status;
@@ -1005,7 +1038,8 @@ impl Simulation {
             }
             tool_forces.push([total.x, total.y, total.z]);
         }
-        let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated);
+        let energy =
+            self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated, &normal_work);
         let tool_offsets = (0..self.model.contacts.len())
             .map(|c| force_control::offset(&self.dofs, c, &x))
             .collect();
@@ -1049,6 +1083,7 @@ impl Simulation {
         eval: &Evaluation,
         tool_forces: &[[f64; 3]],
         dissipated: &[f64],
+        normal_work: &[f64],
     ) -> EnergyBalance {
         let n_u = 3 * self.dofs.n_nodes;
         let e = &mut self.energy;
@@ -1065,6 +1100,11 @@ impl Simulation {
             // The body pushes the tool with +lambda, the tool the body with -lambda.
             e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);
             e.frictional_dissipation[c] += dissipated[c];
+            // The tool's trapezoidal work credits a contact force over the whole
+            // increment's travel; the part spent on the relative normal motion (a gap
+            // closing within the increment) is not work done on the body.
+            e.tool_work -= normal_work[c];
+            e.normal_contact_work += normal_work[c];
         }
         let element =
             crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
@@ -1218,13 +1258,20 @@ pub struct EnergyBalance {
     /// Plastic work dissipated in the body so far (trapezoidal per increment, see
     /// `PointState::plastic_dissipation`).
     pub plastic_dissipation: f64,
-    /// Frictional dissipation per tool: the work of the contact forces on the slip,
-    /// 1/2 (lambda_n + lambda_{n+1}) . delta per node and increment, the same trapezoidal
-    /// rule as the other work terms, which makes the balance exact for elastic bodies. The
-    /// nodes' frictional work Psi (the friction law's variable) uses the paper's
-    /// lambda_{n+1} . delta_t and differs from it where the force changes within an
-    /// increment (a stick-slip transition, a changing mu).
+    /// Frictional dissipation per tool: sum over the contact nodes and increments of
+    /// lambda_t . delta_t, the converged tangential force times the tangential slip
+    /// increment (exactly zero for frictionless contact). The nodes' frictional work Psi
+    /// (the friction law's variable) is the same product, each increment's term clipped
+    /// at zero.
     pub frictional_dissipation: Vec<f64>,
+    /// Work of the normal contact forces on the relative motion of the contact nodes and
+    /// the tools, 1/2 (lambda_n + lambda_{n+1}) . delta - lambda_t . delta_t summed over
+    /// nodes and increments: zero for the exact solution, picked up by the trapezoidal
+    /// rule where a gap closes within an increment (and stored by penalty penetration).
+    /// It is taken out of `tool_work` (not work done on the body), so it is not a term
+    /// of the balance; reported to show the size of that correction.
+    #[serde(default)]
+    pub normal_contact_work: f64,
     /// (work in - stored - dissipated) / scale.
     pub relative_error: f64,
 }
