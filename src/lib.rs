@@ -16,6 +16,7 @@ pub mod contact;
 pub mod element;
 pub mod error;
 pub mod geometry;
+pub mod interrupt;
 pub mod material;
 pub mod mesh;
 pub mod output;

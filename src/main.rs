@@ -84,6 +84,7 @@ fn main() -> ExitCode {
                 restart,
                 ..HostOptions::default()
             };
+            host.interrupt.install_signal_handlers()?;
             script::run_file(&script, &overrides, &host)?;
             eprintln!("results in {}", host.out_dir.display());
             Ok(())
@@ -101,11 +102,17 @@ fn main() -> ExitCode {
                 progress: true,
                 ..HostOptions::default()
             };
-            script::repl::run(script.as_deref(), &host)
+            host.interrupt
+                .install_signal_handlers()
+                .and_then(|()| script::repl::run(script.as_deref(), &host))
         }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e @ tribo::Error::Interrupted(_)) => {
+            eprintln!("{e}: the last converged state and summary.json are in the output folder");
+            ExitCode::from(tribo::interrupt::EXIT_INTERRUPTED)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE

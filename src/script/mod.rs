@@ -12,7 +12,7 @@ mod convert;
 pub mod repl;
 mod stdlib;
 
-pub use api_sim::ScriptSim;
+pub use api_sim::{ScriptSim, Simulations, DEFERRED};
 
 use crate::{Error, Result};
 use rhai::{Dynamic, Engine, EvalAltResult, Position, Scope, AST};
@@ -46,6 +46,10 @@ pub struct HostOptions {
     pub base_settings: rhai::Map,
     /// Show the script's `print` output (a study running many scripts turns it off).
     pub script_print: bool,
+    /// Stop request (SIGINT/SIGTERM): polled between increments and Newton iterations.
+    pub interrupt: crate::interrupt::Interrupt,
+    /// The simulations the script created (the host records stops in their folders).
+    pub simulations: Simulations,
 }
 
 impl Default for HostOptions {
@@ -61,6 +65,8 @@ impl Default for HostOptions {
             warnings: true,
             base_settings: rhai::Map::new(),
             script_print: true,
+            interrupt: crate::interrupt::Interrupt::new(),
+            simulations: Simulations::default(),
         }
     }
 }
@@ -191,14 +197,43 @@ pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
 }
 
 /// Runs a script file to its end.
+///
+/// Every stop is recorded in the output folder of each simulation the script started:
+/// summary.json with the status ("stopped", or "interrupted" after a signal) and the
+/// reason, and checkpoints/final.json with the last converged state (see
+/// `SimState::record_stop`). An interrupt returns `Error::Interrupted`. A `--restart`
+/// checkpoint that no simulation used is an error.
 pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions) -> Result<()> {
+    host.simulations.clear();
     let engine = engine(host, path.parent());
     let ast = compile(&engine, path)?;
     let ast = apply_overrides(&engine, ast, overrides, path)?;
     let mut scope = Scope::new();
-    engine
+    let outcome = engine
         .run_ast_with_scope(&mut scope, &ast)
         .map_err(|e| Error::Script(describe_error(&path.display().to_string(), &e)))
+        .and_then(|()| host.simulations.close());
+    let outcome = outcome.and_then(|()| match &host.restart {
+        Some(file) if !host.restart_used.get() => Err(Error::Input(format!(
+            "--restart {}: the script {} started no simulation, so the checkpoint was not used",
+            file.display(),
+            path.display()
+        ))),
+        _ => Ok(()),
+    });
+    match outcome {
+        Ok(()) => Ok(()),
+        Err(err) if host.interrupt.is_raised() => {
+            let why = host.interrupt.reason();
+            host.simulations.record_stop("interrupted", &why);
+            let _ = err;
+            Err(Error::Interrupted(why))
+        }
+        Err(err) => {
+            host.simulations.record_stop("stopped", &err.to_string());
+            Err(err)
+        }
+    }
 }
 
 /// `--set NAME=VALUE` replaces the value of the script's top-level `let NAME = ...;`

@@ -18,6 +18,7 @@ impl Simulation {
         eval: &Evaluation,
         tool_forces: &[[f64; 3]],
         dissipated: &[f64],
+        normal_work: &[f64],
     ) -> EnergyBalance {
         let n_u = 3 * self.dofs.n_nodes;
         let e = &mut self.energy;
@@ -34,6 +35,11 @@ impl Simulation {
             // The body pushes the tool with +lambda, the tool the body with -lambda.
             e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);
             e.frictional_dissipation[c] += dissipated[c];
+            // The tool's trapezoidal work credits a contact force over the whole
+            // increment's travel; the part spent on the relative normal motion (a gap
+            // closing within the increment) is not work done on the body.
+            e.tool_work -= normal_work[c];
+            e.normal_contact_work += normal_work[c];
         }
         let element =
             crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
@@ -67,7 +73,6 @@ impl Simulation {
         };
         e.clone()
     }
-
 }
 
 /// Energy bookkeeping of a run, cumulative from t = 0.
@@ -84,13 +89,20 @@ pub struct EnergyBalance {
     /// Plastic work dissipated in the body so far (trapezoidal per increment, see
     /// `PointState::plastic_dissipation`).
     pub plastic_dissipation: f64,
-    /// Frictional dissipation per tool: the work of the contact forces on the slip,
-    /// 1/2 (lambda_n + lambda_{n+1}) . delta per node and increment, the same trapezoidal
-    /// rule as the other work terms, which makes the balance exact for elastic bodies. The
-    /// nodes' frictional work Psi (the friction law's variable) uses the paper's
-    /// lambda_{n+1} . delta_t and differs from it where the force changes within an
-    /// increment (a stick-slip transition, a changing mu).
+    /// Frictional dissipation per tool: sum over the contact nodes and increments of
+    /// lambda_t . delta_t, the converged tangential force times the tangential slip
+    /// increment (exactly zero for frictionless contact). The nodes' frictional work Psi
+    /// (the friction law's variable) is the same product, each increment's term clipped
+    /// at zero.
     pub frictional_dissipation: Vec<f64>,
+    /// Work of the normal contact forces on the relative motion of the contact nodes and
+    /// the tools, 1/2 (lambda_n + lambda_{n+1}) . delta - lambda_t . delta_t summed over
+    /// nodes and increments: zero for the exact solution, picked up by the trapezoidal
+    /// rule where a gap closes within an increment (and stored by penalty penetration).
+    /// It is taken out of `tool_work` (not work done on the body), so it is not a term
+    /// of the balance; reported to show the size of that correction.
+    #[serde(default)]
+    pub normal_contact_work: f64,
     /// (work in - stored - dissipated) / scale.
     pub relative_error: f64,
 }

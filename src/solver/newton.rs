@@ -186,6 +186,7 @@ impl Simulation {
         let mut window_start = 0;
         let mut releases = 0;
         loop {
+            self.check_interrupt()?;
             if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
                 ctx.forced = monitor.forced();
                 eval = ctx.evaluate(&x, &mut times)?;

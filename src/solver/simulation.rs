@@ -98,6 +98,8 @@ pub struct Simulation {
     /// Last converged increment (dt, change of the displacements), for the extrapolating
     /// predictor.
     pub(super) last_step: Option<(f64, Vec<f64>)>,
+    /// Stop request polled between Newton iterations (see `crate::interrupt`).
+    pub(super) interrupt: crate::interrupt::Interrupt,
 }
 
 impl Simulation {
@@ -178,6 +180,7 @@ impl Simulation {
                 ..Default::default()
             },
             last_step: None,
+            interrupt: crate::interrupt::Interrupt::new(),
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -306,6 +309,7 @@ impl Simulation {
     /// to `max_cutbacks` times (the sub-increments are all in `history`). Adaptive stepping:
     /// one increment of the size the controller chose (see `step_control`).
     pub fn step(&mut self) -> Result<IncrementReport> {
+        self.check_interrupt()?;
         if self.is_finished() {
             return Err(Error::Input(format!(
                 "the simulation already reached its end time {}",
@@ -316,6 +320,24 @@ impl Simulation {
             StepMode::Fixed => self.step_fixed(),
             StepMode::Adaptive => self.step_adaptive(),
         }
+    }
+
+    /// Connects a stop request: a raised flag abandons the increment under way at its next
+    /// Newton iteration (`Error::Interrupted`); the committed state stays the last
+    /// converged one.
+    pub fn set_interrupt(&mut self, interrupt: crate::interrupt::Interrupt) {
+        self.interrupt = interrupt;
+    }
+
+    pub(super) fn check_interrupt(&self) -> Result<()> {
+        if self.interrupt.is_raised() {
+            return Err(Error::Interrupted(format!(
+                "{}; the increment from t = {} was abandoned",
+                self.interrupt.reason(),
+                self.time
+            )));
+        }
+        Ok(())
     }
 
     fn step_fixed(&mut self) -> Result<IncrementReport> {
@@ -339,6 +361,7 @@ impl Simulation {
                     }
                     return Ok(report);
                 }
+                Err(err @ Error::Interrupted(_)) => return Err(err),
                 Err(err) if retryable(&err) && cutbacks < self.model.settings.max_cutbacks => {
                     cutbacks += 1;
                     dt *= 0.5;
@@ -401,6 +424,7 @@ impl Simulation {
                     self.history.push(report.clone());
                     return Ok(report);
                 }
+                Err(err @ Error::Interrupted(_)) => return Err(err),
                 Err(err) if retryable(&err) && dt_used > dt_min * (1.0 + 1e-9) => {
                     cutbacks += 1;
                     dt = (0.5 * dt_used).max(dt_min);
@@ -545,6 +569,7 @@ impl Simulation {
     ) -> IncrementReport {
         let mut tool_forces = Vec::new();
         let mut dissipated = vec![0.0; self.model.contacts.len()];
+        let mut normal_work = vec![0.0; self.model.contacts.len()];
         let (mut active, mut slipping) = (0, 0);
         for (c, contact) in self.model.contacts.iter().enumerate() {
             let pose = force_control::pose(&self.model, &self.dofs, c, t_new, &x);
@@ -557,8 +582,15 @@ impl Simulation {
                     + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
                 // Work of the contact force on the relative motion, by the trapezoidal rule
                 // like every other work term (Psi below follows the paper instead).
+                // Of it, friction dissipates lambda_t . delta_t (exactly 0 for mu = 0); the
+                // rest is the normal force's work on the relative motion, zero for the exact
+                // solution, which the trapezoidal rule picks up where a gap closes within
+                // the increment (and penalty penetration stores).
                 let relative_motion = xn - pose.to_global_point(&s.x_ref_local);
-                dissipated[c] += 0.5 * (s.lambda + res.f_equi).dot(&relative_motion);
+                let interface = 0.5 * (s.lambda + res.f_equi).dot(&relative_motion);
+                let friction = res.tangential_force.dot(&res.slip_increment);
+                dissipated[c] += friction;
+                normal_work[c] += interface - friction;
                 // The converged force on the tool is F_equi (= lambda for the mixed method).
                 s.lambda = res.f_equi;
                 s.status = res.status;
@@ -600,7 +632,8 @@ impl Simulation {
             }
             tool_forces.push([total.x, total.y, total.z]);
         }
-        let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated);
+        let energy =
+            self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated, &normal_work);
         let tool_offsets = (0..self.model.contacts.len())
             .map(|c| force_control::offset(&self.dofs, c, &x))
             .collect();
