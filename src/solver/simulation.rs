@@ -283,6 +283,11 @@ impl Simulation {
         }
     }
 
+    /// The multiplier elimination, when there is one.
+    pub fn condenser(&self) -> Option<&Condenser> {
+        self.condenser.as_ref()
+    }
+
     /// Multiplier unknowns eliminated before each linear solve.
     pub fn eliminated_multipliers(&self) -> usize {
         self.condenser.as_ref().map_or(0, |c| c.eliminated_count())
