@@ -9,6 +9,7 @@ pub mod force_control;
 pub mod linear;
 pub mod model;
 pub mod simulation;
+pub mod slots;
 pub mod sparse;
 pub mod step_control;
 
