@@ -14,17 +14,18 @@
 
 use super::force_control;
 use super::model::Model;
+use super::slots::AssemblySlots;
 use super::sparse::{SparseMatrix, SparsePattern};
 use crate::contact::{
     alart_curnier, BernsteinLaw, ContactNodeState, Enforcement, FrictionUpdate, NodalContact,
     OperatorParams,
 };
-use crate::element::{hexahedron, in_element, ElementResponse};
+use crate::element::{hexahedron, in_element};
 use crate::geometry::{Mat3, Projection, Vec3};
 use crate::material::PointState;
 use crate::tool::pose::Pose;
 use crate::{Error, Result};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// Where each unknown lives.
@@ -37,6 +38,9 @@ pub struct DofMap {
     /// `force_control`.
     pub tool_offset: Vec<Option<usize>>,
     pub n_dofs: usize,
+    /// Value positions of the element and contact entries in [`Self::pattern`], built on
+    /// first use.
+    slots: OnceLock<Arc<AssemblySlots>>,
 }
 
 impl DofMap {
@@ -61,6 +65,25 @@ impl DofMap {
             lambda_offset,
             tool_offset,
             n_dofs: next,
+            slots: OnceLock::new(),
+        }
+    }
+
+    /// The assembly slots of `pattern` (built from this map by [`Self::pattern`]): computed
+    /// once and kept; a different pattern gets its own, uncached.
+    fn slots(&self, model: &Model, pattern: &Arc<SparsePattern>) -> Arc<AssemblySlots> {
+        let build = || {
+            Arc::new(AssemblySlots::new(
+                model,
+                &self.lambda_offset,
+                pattern.clone(),
+            ))
+        };
+        let cached = self.slots.get_or_init(build);
+        if cached.indexes(pattern) {
+            cached.clone()
+        } else {
+            build()
         }
     }
 
@@ -108,18 +131,28 @@ fn element_threads(setting: usize) -> usize {
     }
 }
 
+/// Element forces and stiffnesses of one evaluation, element after element: `force[24 e..]`
+/// and `stiffness[576 e..]` (column-major), the latter empty for a residual-only
+/// evaluation.
+struct ElementBuffers {
+    force: Vec<f64>,
+    stiffness: Vec<f64>,
+}
+
 /// Evaluates every element at the unknowns `x`, on `threads` threads over contiguous
-/// blocks of elements, writing the trial states of their integration points. Each
-/// element's response is kept and returned in element order, so that the assembly (and
-/// hence every result) is the same whatever the thread count. The first failing element
-/// in element order is the one reported.
+/// blocks of elements, writing the trial states of their integration points and each
+/// element's force (and, with `tangent`, stiffness) straight into its place in the
+/// returned buffers, so that the assembly (and hence every result) is the same whatever
+/// the thread count. The first failing element in element order is the one reported.
 fn evaluate_elements(
     model: &Model,
     x: &[f64],
     committed: &[PointState],
     trial: &mut [PointState],
     threads: usize,
-) -> Result<Vec<ElementResponse<{ crate::element::hex8::DOFS }>>> {
+    tangent: bool,
+) -> Result<ElementBuffers> {
+    const D: usize = crate::element::hex8::DOFS;
     let element = hexahedron(model.settings.kinematics, model.settings.fbar);
     let per_elem = element.point_count();
     let (hexes, nodes, material) = (
@@ -127,37 +160,62 @@ fn evaluate_elements(
         &model.mesh.nodes,
         model.material.as_ref(),
     );
-    let evaluate_block = |first: usize, trial: &mut [PointState]| {
-        let mut out = Vec::with_capacity(trial.len() / per_elem.max(1));
-        let mut xs = [Vec3::zeros(); 8];
-        let mut us = [Vec3::zeros(); 8];
-        for (k, trial_e) in trial.chunks_mut(per_elem).enumerate() {
-            let e = first + k;
-            for (a, &node) in hexes[e].iter().enumerate() {
-                xs[a] = nodes[node];
-                us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
-            }
-            let committed_e = &committed[e * per_elem..(e + 1) * per_elem];
-            let response = element
-                .evaluate(&xs, &us, committed_e, trial_e, material)
-                .map_err(|err| Error::NoConvergence(in_element(err, e).to_string()))?;
-            out.push(response);
-        }
-        Ok::<_, Error>(out)
+    let n_elem = hexes.len();
+    let mut buffers = ElementBuffers {
+        force: vec![0.0; n_elem * D],
+        stiffness: vec![0.0; if tangent { n_elem * D * D } else { 0 }],
     };
+    let evaluate_block =
+        |first: usize, trial: &mut [PointState], force: &mut [f64], stiffness: &mut [f64]| {
+            let mut xs = [Vec3::zeros(); 8];
+            let mut us = [Vec3::zeros(); 8];
+            let mut stiffness = tangent.then(|| stiffness.chunks_mut(D * D));
+            for (k, (trial_e, force_e)) in trial
+                .chunks_mut(per_elem)
+                .zip(force.chunks_mut(D))
+                .enumerate()
+            {
+                let e = first + k;
+                for (a, &node) in hexes[e].iter().enumerate() {
+                    xs[a] = nodes[node];
+                    us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+                }
+                let committed_e = &committed[e * per_elem..(e + 1) * per_elem];
+                let stiffness_e = stiffness.as_mut().and_then(|s| s.next());
+                element
+                    .evaluate_into(
+                        &xs,
+                        &us,
+                        committed_e,
+                        trial_e,
+                        material,
+                        force_e,
+                        stiffness_e,
+                    )
+                    .map_err(|err| Error::NoConvergence(in_element(err, e).to_string()))?;
+            }
+            Ok::<_, Error>(())
+        };
     // Below a few dozen elements, starting threads costs more than it saves.
     const MIN_PARALLEL_ELEMENTS: usize = 64;
-    if threads <= 1 || hexes.len() < MIN_PARALLEL_ELEMENTS {
-        return evaluate_block(0, trial);
+    if threads <= 1 || n_elem < MIN_PARALLEL_ELEMENTS {
+        evaluate_block(0, trial, &mut buffers.force, &mut buffers.stiffness)?;
+        return Ok(buffers);
     }
-    let block = hexes.len().div_ceil(threads);
-    let blocks: Vec<Result<Vec<_>>> = std::thread::scope(|scope| {
+    let block = n_elem.div_ceil(threads);
+    let stiffness_block = if tangent { block * D * D } else { 1 };
+    let mut stiffness_chunks: Vec<&mut [f64]> =
+        buffers.stiffness.chunks_mut(stiffness_block).collect();
+    stiffness_chunks.resize_with(n_elem.div_ceil(block), Default::default);
+    let results: Vec<Result<()>> = std::thread::scope(|scope| {
         let handles: Vec<_> = trial
             .chunks_mut(block * per_elem)
+            .zip(buffers.force.chunks_mut(block * D))
+            .zip(stiffness_chunks)
             .enumerate()
-            .map(|(i, chunk)| {
+            .map(|(i, ((trial, force), stiffness))| {
                 let evaluate_block = &evaluate_block;
-                scope.spawn(move || evaluate_block(i * block, chunk))
+                scope.spawn(move || evaluate_block(i * block, trial, force, stiffness))
             })
             .collect();
         handles
@@ -165,11 +223,10 @@ fn evaluate_elements(
             .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
     });
-    let mut all = Vec::with_capacity(hexes.len());
-    for b in blocks {
-        all.extend(b?);
+    for r in results {
+        r?;
     }
-    Ok(all)
+    Ok(buffers)
 }
 
 /// Wall time spent in each phase of assembly (seconds), accumulated.
@@ -230,25 +287,24 @@ impl IncrementContext<'_> {
         let mut trial_points = self.committed_points.to_vec();
 
         let t0 = Instant::now();
-        let responses = evaluate_elements(
+        let threads = element_threads(model.settings.threads);
+        let slots = self.dofs.slots(model, &self.pattern);
+        let elements = evaluate_elements(
             model,
             x,
             self.committed_points,
             &mut trial_points,
-            element_threads(model.settings.threads),
+            threads,
+            true,
         )?;
-        for (hex, ElementResponse { force, stiffness }) in model.mesh.hexes.iter().zip(&responses) {
+        for (hex, force) in model.mesh.hexes.iter().zip(elements.force.chunks(24)) {
             for (a, &na) in hex.iter().enumerate() {
                 for i in 0..3 {
                     f_int[3 * na + i] += force[3 * a + i];
-                    for (b, &nb) in hex.iter().enumerate() {
-                        for j in 0..3 {
-                            jac.add(3 * na + i, 3 * nb + j, stiffness[(3 * a + i, 3 * b + j)]);
-                        }
-                    }
                 }
             }
         }
+        slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
         times.elements += t0.elapsed().as_secs_f64();
 
         let f_ext = model.external_forces(self.time);
@@ -264,6 +320,7 @@ impl IncrementContext<'_> {
             let pose = &force_control::shifted(&self.poses[c], model, self.dofs, c, x);
             let mut list = Vec::with_capacity(contact.candidates.len());
             for (k, &node) in contact.candidates.iter().enumerate() {
+                let pair_slots = &slots.contact[c][k];
                 let committed = &self.committed_contact[c][k];
                 let xn = model.mesh.nodes[node]
                     + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
@@ -318,7 +375,7 @@ impl IncrementContext<'_> {
                 for i in 0..3 {
                     residual[3 * node + i] += result.f_equi[i];
                     for j in 0..3 {
-                        jac.add(3 * node + i, 3 * node + j, result.equi_x[(i, j)]);
+                        jac.values[pair_slots[0][3 * i + j]] += result.equi_x[(i, j)];
                     }
                 }
                 if let Some(l) = lam_dof {
@@ -337,9 +394,10 @@ impl IncrementContext<'_> {
                     for i in 0..3 {
                         residual[l + i] = result.f_suppl[i];
                         for j in 0..3 {
-                            jac.add(3 * node + i, l + j, result.equi_lambda[(i, j)]);
-                            jac.add(l + i, 3 * node + j, result.suppl_x[(i, j)]);
-                            jac.add(l + i, l + j, result.suppl_lambda[(i, j)]);
+                            let ij = 3 * i + j;
+                            jac.values[pair_slots[1][ij]] += result.equi_lambda[(i, j)];
+                            jac.values[pair_slots[2][ij]] += result.suppl_x[(i, j)];
+                            jac.values[pair_slots[3][ij]] += result.suppl_lambda[(i, j)];
                         }
                     }
                     force_control::add_node_column(&mut jac, model, self.dofs, c, node, l, &result);

@@ -13,6 +13,7 @@ pub mod model;
 pub mod newton;
 pub mod predictor;
 pub mod simulation;
+pub mod slots;
 pub mod sparse;
 pub mod step_control;
 
