@@ -19,6 +19,7 @@ pub mod geometry;
 pub mod material;
 pub mod mesh;
 pub mod output;
+pub mod paths;
 pub mod script;
 pub mod solver;
 pub mod study;
