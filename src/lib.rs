@@ -20,6 +20,7 @@ pub mod interrupt;
 pub mod material;
 pub mod mesh;
 pub mod output;
+pub mod paths;
 pub mod script;
 pub mod solver;
 pub mod study;

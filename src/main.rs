@@ -35,6 +35,8 @@ enum Command {
         /// or at a stop): the script builds the model again, then the state is loaded.
         #[arg(long, value_name = "CHECKPOINT")]
         restart: Option<PathBuf>,
+        #[command(flatten)]
+        limits: Limits,
     },
     /// Speed against accuracy: work-precision charts and stability maps with a report.
     Study {
@@ -53,7 +55,27 @@ enum Command {
         script: Option<PathBuf>,
         #[arg(long)]
         out: Option<PathBuf>,
+        #[command(flatten)]
+        limits: Limits,
     },
+}
+
+/// What a script may read and how much the run may use (see docs/script-api.md, "Limits").
+#[derive(clap::Args)]
+struct Limits {
+    /// A folder scripts may read besides their own (imports, JSON tables); repeatable.
+    #[arg(long = "allow-read", value_name = "DIR")]
+    allow_read: Vec<PathBuf>,
+    /// Largest file a script may read, in MiB.
+    #[arg(long = "max-read-mb", value_name = "MIB", default_value_t = 64)]
+    max_read_mb: u64,
+}
+
+impl Limits {
+    fn apply(&self, host: &mut HostOptions) {
+        host.allow_read = self.allow_read.clone();
+        host.max_read_bytes = self.max_read_mb.saturating_mul(1 << 20);
+    }
 }
 
 fn default_out(script: Option<&PathBuf>) -> PathBuf {
@@ -73,18 +95,20 @@ fn main() -> ExitCode {
             set,
             quiet,
             restart,
+            limits,
         } => (|| {
             let overrides = set
                 .iter()
                 .map(|s| script::parse_override(s))
                 .collect::<tribo::Result<Vec<_>>>()?;
-            let host = HostOptions {
+            let mut host = HostOptions {
                 out_dir: out.unwrap_or_else(|| default_out(Some(&script))),
                 progress: !quiet,
                 restart,
                 ..HostOptions::default()
             };
             host.interrupt.install_signal_handlers()?;
+            limits.apply(&mut host);
             script::run_file(&script, &overrides, &host)?;
             eprintln!("results in {}", host.out_dir.display());
             Ok(())
@@ -96,12 +120,17 @@ fn main() -> ExitCode {
             opts.progress = !quiet;
             tribo::study::run(&name, &opts)
         }
-        Command::Repl { script, out } => {
-            let host = HostOptions {
+        Command::Repl {
+            script,
+            out,
+            limits,
+        } => {
+            let mut host = HostOptions {
                 out_dir: out.unwrap_or_else(|| default_out(script.as_ref())),
                 progress: true,
                 ..HostOptions::default()
             };
+            limits.apply(&mut host);
             host.interrupt
                 .install_signal_handlers()
                 .and_then(|()| script::repl::run(script.as_deref(), &host))

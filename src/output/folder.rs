@@ -1,10 +1,9 @@
 //! The run's output folder. Scripts may write only below it: [`OutputFolder::resolve`] turns a
 //! script-supplied relative path into a path inside the folder and refuses absolute paths, drive
-//! prefixes and any `..` component. (Symbolic links already inside the folder are not followed
-//! or checked: the folder is the run's own.)
+//! prefixes, any `..` component and any symbolic link inside the folder (see [`crate::paths`]).
 
 use crate::{Error, Result};
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
 /// A created output folder.
 #[derive(Clone, Debug)]
@@ -28,51 +27,18 @@ impl OutputFolder {
         &self.root
     }
 
-    /// `root/relative`, after checking `relative` stays below the folder: it must be non-empty,
-    /// relative (no leading `/`, `\` or drive prefix) and contain no `..` component. `.`
-    /// components are dropped. The error names the refused path. Creates nothing.
+    /// `root/relative`, after the checks of [`crate::paths::resolve_write`]: non-empty,
+    /// relative, no `..`, and no symbolic link at any component that exists already (a link
+    /// in the output folder is never followed). The error names the refused path. Creates
+    /// nothing.
     pub fn resolve(&self, relative: &str) -> Result<PathBuf> {
-        let refuse = |why: &str| Error::input("output path", format!("\"{relative}\""), why);
-        let mut out = self.root.clone();
-        let mut named = false;
-        for c in Path::new(relative).components() {
-            match c {
-                Component::Normal(p) => {
-                    out.push(p);
-                    named = true;
-                }
-                Component::CurDir => {}
-                Component::ParentDir => {
-                    return Err(refuse(
-                        "must not contain '..' (scripts may only write below the output folder)",
-                    ));
-                }
-                Component::RootDir | Component::Prefix(_) => {
-                    return Err(refuse(
-                        "must be relative to the output folder (absolute paths are refused)",
-                    ));
-                }
-            }
-        }
-        // On Unix a backslash is an ordinary character, but a name like "..\x" or "\x" would
-        // mean something else on Windows: refuse such paths everywhere for portable scripts.
-        if relative.contains('\\') {
-            return Err(refuse("must use '/' as separator"));
-        }
-        if !named {
-            return Err(refuse("must name a file or folder below the output folder"));
-        }
-        Ok(out)
+        crate::paths::resolve_write(&self.root, relative, false)
     }
 
-    /// Like [`resolve`](Self::resolve), and creates the parent folders of the result, ready for
-    /// writing a file there.
+    /// Like [`resolve`](Self::resolve), and creates the parent folders of the result (one by
+    /// one, never through a link), ready for writing a file there.
     pub fn resolve_for_write(&self, relative: &str) -> Result<PathBuf> {
-        let path = self.resolve(relative)?;
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
-        }
-        Ok(path)
+        crate::paths::resolve_write(&self.root, relative, true)
     }
 }
 

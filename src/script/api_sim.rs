@@ -1013,7 +1013,9 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         move |path: &str, text: &str| -> ScriptResult<String> {
             let folder = lift(crate::output::OutputFolder::create(&h.out_dir))?;
             let file = lift(folder.resolve_for_write(path))?;
-            lift(std::fs::write(&file, text).map_err(|e| Error::io(&file, e)))?;
+            lift(crate::paths::create_file(&file)
+                .and_then(|mut f| std::io::Write::write_all(&mut f, text.as_bytes()))
+                .map_err(|e| Error::io(&file, e)))?;
             Ok(file.display().to_string())
         },
     );

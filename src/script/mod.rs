@@ -14,6 +14,7 @@ mod stdlib;
 
 pub use api_sim::{ScriptSim, Simulations, DEFERRED};
 
+use crate::paths::ReadPolicy;
 use crate::{Error, Result};
 use rhai::{Dynamic, Engine, EvalAltResult, Position, Scope, AST};
 use std::path::{Path, PathBuf};
@@ -50,6 +51,10 @@ pub struct HostOptions {
     pub interrupt: crate::interrupt::Interrupt,
     /// The simulations the script created (the host records stops in their folders).
     pub simulations: Simulations,
+    /// Folders scripts may read besides their own (`--allow-read DIR`).
+    pub allow_read: Vec<PathBuf>,
+    /// Largest file a script may read (imports, JSON tables), in bytes.
+    pub max_read_bytes: u64,
 }
 
 impl Default for HostOptions {
@@ -67,6 +72,8 @@ impl Default for HostOptions {
             script_print: true,
             interrupt: crate::interrupt::Interrupt::new(),
             simulations: Simulations::default(),
+            allow_read: Vec::new(),
+            max_read_bytes: crate::paths::DEFAULT_MAX_READ_BYTES,
         }
     }
 }
@@ -80,17 +87,28 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.set_max_string_size(1 << 20);
     engine.set_max_array_size(1 << 22);
     engine.set_max_map_size(1 << 16);
-    engine.set_module_resolver(stdlib::resolver(script_dir));
+    let policy = Rc::new(read_policy(host, script_dir).unwrap_or_else(|_| ReadPolicy::nothing()));
+    engine.set_module_resolver(stdlib::resolver(policy.clone()));
     if !host.script_print {
         engine.on_print(|_| {});
     }
     let host = Rc::new(host.clone());
     api_scene::register(&mut engine, host.clone());
-    api_tools::register(&mut engine, script_dir);
+    api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);
     register_checks(&mut engine);
     engine
+}
+
+/// Where the script at `script_dir` may read: its folder and the `--allow-read` folders
+/// (an error names a folder that cannot be opened).
+pub fn read_policy(host: &HostOptions, script_dir: Option<&Path>) -> Result<ReadPolicy> {
+    ReadPolicy::new(
+        script_dir.unwrap_or(Path::new(".")),
+        &host.allow_read,
+        host.max_read_bytes,
+    )
 }
 
 /// Assertions for scripted test cases: a failed one stops the script with its message.
@@ -205,6 +223,7 @@ pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
 /// checkpoint that no simulation used is an error.
 pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions) -> Result<()> {
     host.simulations.clear();
+    read_policy(host, path.parent())?;
     let engine = engine(host, path.parent());
     let ast = compile(&engine, path)?;
     let ast = apply_overrides(&engine, ast, overrides, path)?;
