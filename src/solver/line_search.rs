@@ -37,10 +37,18 @@ impl Simulation {
         let mut last_err = None;
         for cut in 0..=LINE_SEARCH_CUTS {
             let xn = trial_x(alpha);
-            match ctx.evaluate(&xn, times) {
+            // The full step, usually accepted, is evaluated whole; a cut only for its
+            // residual, and whole once accepted.
+            let evaluated = if cut == 0 {
+                ctx.evaluate(&xn, times)
+            } else {
+                ctx.evaluate_residual(&xn, times)
+            };
+            match evaluated {
                 Ok(e) => {
                     let m = self.residual_record(&e, weights).1;
                     if m.is_finite() && m <= (1.0 - 1e-4 * alpha) * merit0 {
+                        let e = if e.has_jacobian() { e } else { ctx.evaluate(&xn, times)? };
                         return Ok((xn, e, cut));
                     }
                     if m.is_finite() && best.as_ref().is_none_or(|b| m < b.0) {
@@ -52,7 +60,10 @@ impl Simulation {
             alpha *= 0.5;
         }
         match (best, last_err) {
-            (Some((_, xn, e)), _) => Ok((xn, e, LINE_SEARCH_CUTS)),
+            (Some((_, xn, e)), _) => {
+                let e = if e.has_jacobian() { e } else { ctx.evaluate(&xn, times)? };
+                Ok((xn, e, LINE_SEARCH_CUTS))
+            }
             (None, Some(err)) => Err(err),
             (None, None) => Err(Error::NoConvergence(
                 "non-finite residual at every line-search step".into(),
