@@ -100,6 +100,8 @@ pub struct Simulation {
     pub(super) last_step: Option<(f64, Vec<f64>)>,
     /// Stop request polled between Newton iterations (see `crate::interrupt`).
     pub(super) interrupt: crate::interrupt::Interrupt,
+    /// Whether the run has explained contact-status cycling to the user (once per run).
+    pub(super) cycling_explained: bool,
 }
 
 impl Simulation {
@@ -181,6 +183,7 @@ impl Simulation {
             },
             last_step: None,
             interrupt: crate::interrupt::Interrupt::new(),
+            cycling_explained: false,
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -482,43 +485,15 @@ impl Simulation {
             trial.residuals,
         );
         report.line_search_cuts = trial.line_search_cuts;
-        if !trial.cycling.is_empty() {
-            let nodes: Vec<String> = trial
-                .cycling
-                .iter()
-                .map(|n| {
-                    format!(
-                        "{}:{} ({} flips{})",
-                        self.model.contacts[n.tool].tool.name,
-                        n.node,
-                        n.flips,
-                        n.frozen
-                            .as_ref()
-                            .map(|s| format!(", frozen {s}"))
-                            .unwrap_or_default()
-                    )
-                })
-                .collect();
-            // A long run prints this every increment: name the first few nodes only (the
-            // full list is in the report), and the free-law residual only when statuses
-            // were frozen (otherwise it is the converged residual).
-            const SHOWN: usize = 8;
-            let more = nodes.len().saturating_sub(SHOWN);
-            let frozen = trial.cycling.iter().any(|n| n.frozen.is_some());
-            report.warnings.push(format!(
-                "contact status cycled at {} node(s): {}{}{}",
-                nodes.len(),
-                nodes[..nodes.len().min(SHOWN)].join(", "),
-                if more > 0 { format!(" and {more} more") } else { String::new() },
-                // Frozen statuses are always released before an increment is accepted, so
-                // the last residual is the free law's.
-                match report.residuals.last().filter(|_| frozen) {
-                    Some(free) => format!(
-                        "; free-law residual at the converged state: force {:.3e} relative, contact {:.3e}",
-                        free.force_rel, free.contact
-                    ),
-                    None => String::new(),
-                }
+        // Cycling is worth one explanation per run, not one line per increment: the nodes
+        // of every increment are in its report and in history.csv (cycling_nodes).
+        if !trial.cycling.is_empty() && !self.cycling_explained {
+            self.cycling_explained = true;
+            report.warnings.push(cycling_warning(
+                &self.model,
+                &trial.cycling,
+                report.index,
+                self.model.settings.stepping.anti_cycling,
             ));
         }
         report.cycling = trial.cycling;
@@ -775,4 +750,34 @@ impl Simulation {
         }
         Ok(())
     }
+}
+
+/// The one warning of a run about contact-status cycling: where it happened first, whether
+/// the result is sound, and what to try.
+fn cycling_warning(
+    model: &Model,
+    cycling: &[CyclingNode],
+    increment: usize,
+    treatment: super::step_control::AntiCycling,
+) -> String {
+    const SHOWN: usize = 5;
+    let nodes: Vec<String> = cycling
+        .iter()
+        .take(SHOWN)
+        .map(|n| format!("{}:{} ({} flips)", model.contacts[n.tool].tool.name, n.node, n.flips))
+        .collect();
+    let more = cycling.len().saturating_sub(SHOWN);
+    format!(
+        "from increment {increment} on, the contact status of some barely touching nodes changes back and forth during Newton's iterations (here {} node(s): {}{}). \
+         Each increment is still accepted only when the unmodified friction law holds to the Newton tolerances, so the results are sound; cycling costs iterations. \
+         If increments take many iterations or are cut back, try smaller increments (increments, or step_control: \"adaptive\"){}. \
+         Not repeated: the count per increment is the column cycling_nodes of history.csv.",
+        cycling.len(),
+        nodes.join(", "),
+        if more > 0 { format!(" and {more} more") } else { String::new() },
+        match treatment {
+            super::step_control::AntiCycling::Off => ", or anti_cycling: \"freeze\"",
+            _ => "",
+        }
+    )
 }
