@@ -35,11 +35,7 @@ struct Session {
 
 impl Session {
     fn start(script: &Path, out: &Path) -> Session {
-        let command = format!(
-            "{BIN} repl {} --out {}",
-            script.display(),
-            out.display()
-        );
+        let command = format!("{BIN} repl {} --out {}", script.display(), out.display());
         let mut child = Command::new("script")
             .args(["-q", "-e", "-c", &command, "/dev/null"])
             .env("TERM", "dumb")
@@ -58,10 +54,16 @@ impl Session {
                 if n == 0 {
                     break;
                 }
-                sink.lock().unwrap().push_str(&String::from_utf8_lossy(&buf[..n]));
+                sink.lock()
+                    .unwrap()
+                    .push_str(&String::from_utf8_lossy(&buf[..n]));
             }
         });
-        Session { child, input, output }
+        Session {
+            child,
+            input,
+            output,
+        }
     }
 
     fn send(&mut self, bytes: &[u8]) {
@@ -116,20 +118,33 @@ fn ctrl_c_during_run_returns_to_the_prompt_and_stepping_goes_on() {
     // Loading stops at the loop's first sim.step(): nothing stepped.
     let at = s.expect(0, "up to its first sim.step() (line 11;");
     let at = s.expect(at, "tribo> ");
-    assert!(!s.output.lock().unwrap().contains("the loop ran while loading"));
+    assert!(!s
+        .output
+        .lock()
+        .unwrap()
+        .contains("the loop ran while loading"));
     assert_eq!(history_rows(&out), 0);
 
     s.send(b"sim.run()\r");
     let start = Instant::now();
     while history_rows(&out) < 20 {
-        assert!(start.elapsed() < Duration::from_secs(300), "sim.run() makes no progress");
+        assert!(
+            start.elapsed() < Duration::from_secs(300),
+            "sim.run() makes no progress"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
     s.send(&[0x03]);
-    let at = s.expect(at, "interrupted: back at the last converged increment (t = ");
+    let at = s.expect(
+        at,
+        "interrupted: back at the last converged increment (t = ",
+    );
     let at = s.expect(at, "tribo> ");
     let converged = history_rows(&out);
-    assert!((20..300).contains(&converged), "{converged} increments before Ctrl-C");
+    assert!(
+        (20..300).contains(&converged),
+        "{converged} increments before Ctrl-C"
+    );
 
     // The simulation is where it was interrupted and steps on from there.
     s.send(b"sim.history().len()\r");
@@ -144,7 +159,10 @@ fn ctrl_c_during_run_returns_to_the_prompt_and_stepping_goes_on() {
     let _ = at;
     let start = Instant::now();
     while s.child.try_wait().unwrap().is_none() {
-        assert!(start.elapsed() < Duration::from_secs(60), "the REPL did not quit");
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the REPL did not quit"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     let _ = std::fs::remove_dir_all(&dir);
