@@ -52,7 +52,8 @@ fn an_untouched_checkpoint_is_accepted() {
 fn tampered_values_are_refused_naming_the_field() {
     let base = checkpoint_json();
     let k = active_node(&base);
-    let cases: Vec<(&str, Box<dyn Fn(&mut Value)>, String)> = vec![
+    type Tamper = Box<dyn Fn(&mut Value)>;
+    let cases: Vec<(&str, Tamper, String)> = vec![
         (
             "negative mu",
             Box::new(move |j: &mut Value| j["state"]["contact"][0][k]["mu"] = (-3.0).into()),
@@ -104,7 +105,9 @@ fn tampered_values_are_refused_naming_the_field() {
         assert!(err.contains(&expected), "{what}: {err}");
     }
     // A value JSON cannot hold as a finite f64 does not even parse.
-    let text = base.to_string().replacen("\"mu\":", "\"mu\":1e999,\"x\":", 1);
+    let text = base
+        .to_string()
+        .replacen("\"mu\":", "\"mu\":1e999,\"x\":", 1);
     assert!(Checkpoint::from_json(&text, "tampered.json").is_err());
 }
 

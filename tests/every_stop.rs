@@ -91,14 +91,20 @@ fn a_friction_law_returning_nan_mid_run_stops_with_summary_and_final_checkpoint(
     // mu is fine while sticking; once a node has slipped 0.01 mm the law returns NaN.
     let s = run_until_stop(
         "nan_law",
-        &scene("if slip > 0.01 { (-1.0).sqrt() } else { 0.25 }", "sim.run();"),
+        &scene(
+            "if slip > 0.01 { (-1.0).sqrt() } else { 0.25 }",
+            "sim.run();",
+        ),
         |_| {},
     );
     assert_eq!(s.summary["status"], "stopped");
     let reason = s.summary["error"].as_str().unwrap();
     assert!(reason.contains("NaN"), "{reason}");
     assert!(reason.contains("friction coefficient"), "{reason}");
-    assert!(reason.contains("nan_law.rhai:"), "the reason says where: {reason}");
+    assert!(
+        reason.contains("nan_law.rhai:"),
+        "the reason says where: {reason}"
+    );
     // Increments 1, 2 press, 3 slips: its law call fails after it converged.
     assert_final_state(&s, 3);
 }
@@ -117,7 +123,11 @@ fn a_non_converging_increment_stops_with_summary_and_final_checkpoint() {
     let reason = s.summary["error"].as_str().unwrap();
     assert!(reason.contains("no convergence"), "{reason}");
     assert!(reason.contains("increment 3"), "{reason}");
-    assert!(s.error.contains("last converged state (t = 1) saved in"), "{}", s.error);
+    assert!(
+        s.error.contains("last converged state (t = 1) saved in"),
+        "{}",
+        s.error
+    );
     assert_final_state(&s, 2);
 }
 
@@ -125,13 +135,19 @@ fn a_non_converging_increment_stops_with_summary_and_final_checkpoint() {
 fn a_script_error_after_some_increments_stops_with_summary_and_final_checkpoint() {
     let s = run_until_stop(
         "script_error",
-        &scene("0.25", "sim.step(); sim.step();\nthrow \"the post-processing failed\";"),
+        &scene(
+            "0.25",
+            "sim.step(); sim.step();\nthrow \"the post-processing failed\";",
+        ),
         |_| {},
     );
     assert_eq!(s.summary["status"], "stopped");
     let reason = s.summary["error"].as_str().unwrap();
     assert!(reason.contains("the post-processing failed"), "{reason}");
-    assert!(reason.contains("script_error.rhai:10:"), "file and line: {reason}");
+    assert!(
+        reason.contains("script_error.rhai:10:"),
+        "file and line: {reason}"
+    );
     assert_final_state(&s, 2);
 }
 
@@ -143,9 +159,15 @@ fn a_frame_that_cannot_be_written_stops_with_summary_and_final_checkpoint() {
     });
     assert_eq!(s.summary["status"], "stopped");
     let reason = s.summary["error"].as_str().unwrap();
-    assert!(reason.contains("frame_0002.vtu"), "names the file: {reason}");
+    assert!(
+        reason.contains("frame_0002.vtu"),
+        "names the file: {reason}"
+    );
     assert_final_state(&s, 2);
-    assert!(s.dir.join("frames/frame_0001.vtu").is_file(), "earlier frames kept");
+    assert!(
+        s.dir.join("frames/frame_0001.vtu").is_file(),
+        "earlier frames kept"
+    );
 }
 
 #[test]

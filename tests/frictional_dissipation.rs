@@ -43,7 +43,10 @@ fn frictionless_contact_dissipates_exactly_nothing() {
     // Linear elasticity: the trapezoidal work of the body is its stored energy exactly, so
     // the two agree to round-off (measured 2e-14); before the fix the tool work was larger
     // by the normal contact work (3 % here), and the friction term held it.
-    assert!(gap <= 1e-10, "tool work and elastic energy differ by {gap:e}");
+    assert!(
+        gap <= 1e-10,
+        "tool work and elastic energy differ by {gap:e}"
+    );
     assert!(e.relative_error.abs() <= 1e-10, "{e:?}");
 }
 
@@ -62,7 +65,10 @@ fn frictionless_press_tool_work_is_the_stored_energy() {
     }
     let e = sim.energy();
     assert_eq!(e.frictional_dissipation, vec![0.0]);
-    assert!(e.normal_contact_work > 0.0, "the gap closes within the first increment");
+    assert!(
+        e.normal_contact_work > 0.0,
+        "the gap closes within the first increment"
+    );
     let rel = (e.tool_work - e.elastic_energy).abs() / e.elastic_energy;
     println!(
         "press: tool work {} elastic {} rel {rel:e}, normal contact work {}",

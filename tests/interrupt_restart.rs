@@ -112,7 +112,10 @@ fn a_signal_stops_the_cup_and_restart_reproduces_the_uninterrupted_run() {
                 child.try_wait().unwrap().is_none(),
                 "{name}: the run ended before the signal"
             );
-            assert!(start.elapsed() < Duration::from_secs(300), "{name}: no progress");
+            assert!(
+                start.elapsed() < Duration::from_secs(300),
+                "{name}: no progress"
+            );
             std::thread::sleep(Duration::from_millis(5));
         }
         let sent = Command::new("kill")
@@ -124,7 +127,10 @@ fn a_signal_stops_the_cup_and_restart_reproduces_the_uninterrupted_run() {
         let mut stderr = String::new();
         std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
         assert_eq!(status.code(), Some(130), "{name}: {stderr}");
-        assert!(stderr.contains(&format!("interrupted: {name} received")), "{stderr}");
+        assert!(
+            stderr.contains(&format!("interrupted: {name} received")),
+            "{stderr}"
+        );
 
         let stopped = summary(&dir);
         assert_eq!(stopped["status"], "interrupted", "{name}");
@@ -132,7 +138,10 @@ fn a_signal_stops_the_cup_and_restart_reproduces_the_uninterrupted_run() {
         let final_ck = dir.join("checkpoints/final.json");
         assert!(final_ck.is_file(), "{name}: final checkpoint");
         let increments = stopped["increments"].as_u64().unwrap();
-        assert!((8..60).contains(&increments), "{name}: stopped after {increments}");
+        assert!(
+            (8..60).contains(&increments),
+            "{name}: stopped after {increments}"
+        );
         // history.csv holds exactly the converged increments of the checkpoint.
         assert_eq!(rows(&dir.join("history.csv")) as u64, increments);
 

@@ -238,7 +238,12 @@ impl RunOutput {
     }
 
     /// Writes summary.json for a run that stopped before its end (see [`Stop`]).
-    pub fn write_stop_summary(&self, sim: &Simulation, wall_time_s: f64, stop: &Stop) -> Result<()> {
+    pub fn write_stop_summary(
+        &self,
+        sim: &Simulation,
+        wall_time_s: f64,
+        stop: &Stop,
+    ) -> Result<()> {
         self.write_summary_of(sim, wall_time_s, Some(stop))
     }
 
@@ -340,7 +345,11 @@ pub fn remove_stale_temporaries(root: &Path) -> Vec<(std::path::PathBuf, u32)> {
     if !proc_fs {
         return removed;
     }
-    for dir in [root.to_path_buf(), root.join("frames"), root.join("checkpoints")] {
+    for dir in [
+        root.to_path_buf(),
+        root.join("frames"),
+        root.join("checkpoints"),
+    ] {
         let Ok(entries) = std::fs::read_dir(&dir) else {
             continue;
         };
@@ -373,43 +382,6 @@ fn stale_temporary_pid(name: &str) -> Option<u32> {
         return None;
     }
     pid.parse().ok()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn only_our_temporaries_of_dead_processes_are_removed() {
-        assert_eq!(stale_temporary_pid(".checkpoint_0004.json.4242.tmp"), Some(4242));
-        assert_eq!(stale_temporary_pid(".frame_0001.vtu.7.tmp"), Some(7));
-        for other in [
-            "checkpoint_0004.json.4242.tmp",
-            ".checkpoint_0004.json.42a.tmp",
-            ".notes.txt.4242.tmp",
-            ".json.4242.tmp",
-            ".checkpoint_0004.json..tmp",
-            ".checkpoint_0004.json.4242.tmp~",
-        ] {
-            assert_eq!(stale_temporary_pid(other), None, "{other}");
-        }
-        let root = crate::output::test_util::temp_dir("stale");
-        std::fs::create_dir_all(root.join("checkpoints")).unwrap();
-        // A PID above the kernel's pid_max (4194304) is never running.
-        let dead = root.join("checkpoints/.checkpoint_0002.json.99999999.tmp");
-        let alive = root.join(format!(
-            "checkpoints/.checkpoint_0003.json.{}.tmp",
-            std::process::id()
-        ));
-        let foreign = root.join("checkpoints/.mine.txt.99999999.tmp");
-        for f in [&dead, &alive, &foreign] {
-            std::fs::write(f, "x").unwrap();
-        }
-        let removed = remove_stale_temporaries(&root);
-        assert_eq!(removed, vec![(dead.clone(), 99999999)]);
-        assert!(!dead.exists() && alive.exists() && foreign.exists());
-        let _ = std::fs::remove_dir_all(&root);
-    }
 }
 
 /// The committed state as a VTK frame: displacement and contact fields on the nodes (and,
@@ -517,5 +489,45 @@ pub fn frame(sim: &Simulation) -> Frame {
             Field::scalar("von_mises", von_mises),
             Field::scalar("equivalent_plastic_strain", eq_plastic),
         ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_our_temporaries_of_dead_processes_are_removed() {
+        assert_eq!(
+            stale_temporary_pid(".checkpoint_0004.json.4242.tmp"),
+            Some(4242)
+        );
+        assert_eq!(stale_temporary_pid(".frame_0001.vtu.7.tmp"), Some(7));
+        for other in [
+            "checkpoint_0004.json.4242.tmp",
+            ".checkpoint_0004.json.42a.tmp",
+            ".notes.txt.4242.tmp",
+            ".json.4242.tmp",
+            ".checkpoint_0004.json..tmp",
+            ".checkpoint_0004.json.4242.tmp~",
+        ] {
+            assert_eq!(stale_temporary_pid(other), None, "{other}");
+        }
+        let root = crate::output::test_util::temp_dir("stale");
+        std::fs::create_dir_all(root.join("checkpoints")).unwrap();
+        // A PID above the kernel's pid_max (4194304) is never running.
+        let dead = root.join("checkpoints/.checkpoint_0002.json.99999999.tmp");
+        let alive = root.join(format!(
+            "checkpoints/.checkpoint_0003.json.{}.tmp",
+            std::process::id()
+        ));
+        let foreign = root.join("checkpoints/.mine.txt.99999999.tmp");
+        for f in [&dead, &alive, &foreign] {
+            std::fs::write(f, "x").unwrap();
+        }
+        let removed = remove_stale_temporaries(&root);
+        assert_eq!(removed, vec![(dead.clone(), 99999999)]);
+        assert!(!dead.exists() && alive.exists() && foreign.exists());
+        let _ = std::fs::remove_dir_all(&root);
     }
 }

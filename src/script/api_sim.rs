@@ -137,7 +137,8 @@ impl Simulations {
     pub fn close(&self) -> crate::Result<()> {
         for s in self.0.borrow().iter() {
             if let Ok(mut st) = s.try_borrow_mut() {
-                st.write_due_checkpoint().map_err(|e| Error::Script(e.to_string()))?;
+                st.write_due_checkpoint()
+                    .map_err(|e| Error::Script(e.to_string()))?;
             }
         }
         Ok(())
@@ -347,7 +348,8 @@ impl SimState {
             }
             let ck = self.checkpoint_every;
             if ck > 0 && (report.index % ck == 0 || sim.is_finished()) {
-                self.checkpoint_due = Some(format!("checkpoints/checkpoint_{:04}.json", report.index));
+                self.checkpoint_due =
+                    Some(format!("checkpoints/checkpoint_{:04}.json", report.index));
             }
         }
         let snapshot = (0..sim.model.contacts.len())

@@ -100,13 +100,21 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
 /// What the REPL prints after evaluating a line. After Ctrl-C (the host's interrupt flag)
 /// the flag is withdrawn, so that the next line steps again, and the message gives the
 /// time of the state kept.
-pub fn outcome_line(result: &std::result::Result<Dynamic, Box<EvalAltResult>>, host: &HostOptions) -> String {
+pub fn outcome_line(
+    result: &std::result::Result<Dynamic, Box<EvalAltResult>>,
+    host: &HostOptions,
+) -> String {
     match result {
         Ok(v) if v.is_unit() => String::new(),
         Ok(v) => v.to_string(),
         Err(_) if host.interrupt.is_raised() => {
             host.interrupt.clear();
-            let times: Vec<String> = host.simulations.times().iter().map(|t| t.to_string()).collect();
+            let times: Vec<String> = host
+                .simulations
+                .times()
+                .iter()
+                .map(|t| t.to_string())
+                .collect();
             format!(
                 "interrupted: back at the last converged increment (t = {}); sim.step() goes on from there",
                 times.join(", ")
@@ -119,7 +127,9 @@ pub fn outcome_line(result: &std::result::Result<Dynamic, Box<EvalAltResult>>, h
 /// Whether loading stopped at the script's first `sim.step()` (see `DEFERRED`).
 fn is_deferred(e: &EvalAltResult) -> bool {
     match e {
-        EvalAltResult::ErrorTerminated(v, _) => v.clone().into_string().is_ok_and(|s| s == DEFERRED),
+        EvalAltResult::ErrorTerminated(v, _) => {
+            v.clone().into_string().is_ok_and(|s| s == DEFERRED)
+        }
         EvalAltResult::ErrorInFunctionCall(_, _, inner, _) => is_deferred(inner),
         _ => false,
     }

@@ -303,9 +303,15 @@ impl Checkpoint {
             if i < n_u {
                 if !(v.abs() <= bound) {
                     return refuse(
-                        format!("state.x[{i}] (displacement {} of node {})", ["x", "y", "z"][i % 3], i / 3),
+                        format!(
+                            "state.x[{i}] (displacement {} of node {})",
+                            ["x", "y", "z"][i % 3],
+                            i / 3
+                        ),
                         v,
-                        &format!("must be finite and within +-{bound:e} (1000 times the mesh's size)"),
+                        &format!(
+                            "must be finite and within +-{bound:e} (1000 times the mesh's size)"
+                        ),
                     );
                 }
             } else {
@@ -319,7 +325,10 @@ impl Checkpoint {
                 ("strain", point.strain.as_slice()),
                 ("plastic_strain", point.plastic_strain.as_slice()),
                 ("log_stress", point.log_stress.as_slice()),
-                ("deformation_gradient", point.deformation_gradient.as_slice()),
+                (
+                    "deformation_gradient",
+                    point.deformation_gradient.as_slice(),
+                ),
             ] {
                 for (i, &v) in values.iter().enumerate() {
                     finite(&|| format!("{}[{i}]", field(name)), v)?;
@@ -339,7 +348,11 @@ impl Checkpoint {
         for (c, nodes) in s.contact.iter().enumerate() {
             for (k, n) in nodes.iter().enumerate() {
                 let field = |name: &str| format!("state.contact[{c}][{k}].{name}");
-                for (name, v) in [("lambda", n.lambda), ("x_ref_local", n.x_ref_local), ("normal", n.normal)] {
+                for (name, v) in [
+                    ("lambda", n.lambda),
+                    ("x_ref_local", n.x_ref_local),
+                    ("normal", n.normal),
+                ] {
                     for (i, &x) in v.iter().enumerate() {
                         finite(&|| format!("{}[{i}]", field(name)), x)?;
                     }
@@ -369,7 +382,11 @@ impl Checkpoint {
             finite(&|| format!("state.energy.frictional_dissipation[{c}]"), v)?;
         }
         if !(s.controller.dt > 0.0 && s.controller.dt.is_finite()) {
-            return refuse("state.controller.dt".into(), s.controller.dt, "must be finite and > 0");
+            return refuse(
+                "state.controller.dt".into(),
+                s.controller.dt,
+                "must be finite and > 0",
+            );
         }
         if let Some((dt, du)) = &s.last_step {
             finite(&|| "state.last_step.dt".into(), *dt)?;

@@ -612,8 +612,7 @@ impl Simulation {
             }
             tool_forces.push([total.x, total.y, total.z]);
         }
-        let energy =
-            self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated, &normal_work);
+        let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated, &normal_work);
         let tool_offsets = (0..self.model.contacts.len())
             .map(|c| force_control::offset(&self.dofs, c, &x))
             .collect();
