@@ -11,6 +11,8 @@ pub mod model;
 pub mod simulation;
 pub mod sparse;
 pub mod step_control;
+pub mod symmetric_lu;
+pub mod system_dump;
 
 pub use model::{Model, SolverSettings};
 pub use simulation::{IncrementReport, IterationRecord, Simulation};

@@ -8,7 +8,7 @@ use super::checkpoint::SavedState;
 use super::condense::Condenser;
 use super::cycling::{CyclingMonitor, CyclingNode};
 use super::force_control;
-use super::linear::{FaerLu, LinearSolver};
+use super::linear::{LinearSolver, Solver};
 use super::model::Model;
 use super::sparse::SparsePattern;
 use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
@@ -107,7 +107,7 @@ pub struct Simulation {
     dofs: DofMap,
     pattern: Arc<SparsePattern>,
     is_fixed: Vec<bool>,
-    linear: FaerLu,
+    linear: Solver,
     condenser: Option<Condenser>,
     /// Committed unknowns [u, lambda].
     x: Vec<f64>,
@@ -145,7 +145,8 @@ impl Simulation {
         }
         force_control::check(&model)?;
         let dofs = DofMap::new(&model);
-        let pattern = Arc::new(dofs.pattern(&model));
+        let groups = super::condense::elimination_groups(&model, &dofs);
+        let pattern = Arc::new(dofs.pattern(&model).with_groups(groups));
         let mut is_fixed = vec![false; dofs.n_dofs];
         for bc in &model.dirichlet {
             for &node in &bc.nodes {
@@ -195,7 +196,7 @@ impl Simulation {
             dofs,
             pattern,
             is_fixed,
-            linear: FaerLu::default(),
+            linear: Solver::new(model.settings.linear_solver),
             points,
             contact,
             time: 0.0,
@@ -310,7 +311,7 @@ impl Simulation {
     }
 
     /// Solves J dx = -R, through the condensed system when multipliers are eliminated.
-    pub fn newton_step(&self, eval: &Evaluation, linear: &mut FaerLu) -> Result<Vec<f64>> {
+    pub fn newton_step(&self, eval: &Evaluation, linear: &mut dyn LinearSolver) -> Result<Vec<f64>> {
         // Tool offsets couple to every node of their tool: kept out of the sparse LU.
         let border: Vec<usize> = self.dofs.tool_offset.iter().flatten().copied().collect();
         match &self.condenser {
@@ -335,7 +336,7 @@ impl Simulation {
 
     /// How many symbolic LU analyses were done: one per sparsity pattern, not per iteration.
     pub fn symbolic_analyses(&self) -> usize {
-        self.linear.symbolic_count
+        self.linear.symbolic_analyses()
     }
 
     /// Committed unknowns [u, lambda].
@@ -656,7 +657,7 @@ impl Simulation {
         text
     }
 
-    fn newton(&self, t_new: f64, linear: &mut FaerLu) -> Result<Trial> {
+    fn newton(&self, t_new: f64, linear: &mut dyn LinearSolver) -> Result<Trial> {
         let settings = self.model.settings.clone();
         let step = &settings.stepping;
         let mut x = self.x.clone();
@@ -889,7 +890,7 @@ impl Simulation {
         ctx: &IncrementContext<'_>,
         t_new: f64,
         x: &mut [f64],
-        linear: &mut FaerLu,
+        linear: &mut dyn LinearSolver,
         times: &mut PhaseTimes,
     ) -> Result<()> {
         let jumps: Vec<(usize, f64)> = self
@@ -1151,6 +1152,9 @@ impl Simulation {
             ));
         }
         settings.stepping.validate(settings.end_time)?;
+        if settings.linear_solver != old.linear_solver {
+            self.linear = Solver::new(settings.linear_solver);
+        }
         let (lo, hi) = (
             settings.stepping.dt_min(settings.end_time),
             settings.stepping.dt_max(settings.end_time),
