@@ -550,6 +550,11 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
                     .map_err(|t| format!("eliminate_multipliers must be true or false, got {t}"))
                     .or_else(runtime_error)?
             }
+            "linear_solver" => {
+                let name = v.clone().into_string().unwrap_or_default();
+                s.linear_solver = crate::solver::linear::LinearSolverKind::from_name(&name)
+                    .or_else(runtime_error)?
+            }
             "kinematics" => {
                 let name = v.clone().into_string().unwrap_or_default();
                 s.kinematics = lift(crate::element::StrainTheory::from_name(&name))?;
@@ -590,7 +595,7 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, extrapolate, threads, kinematics, fbar, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
+                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, linear_solver, extrapolate, threads, kinematics, fbar, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
                 ))
             }
         }

@@ -39,6 +39,27 @@ use super::sparse::{SparseMatrix, SparsePattern};
 use crate::Result;
 use std::sync::Arc;
 
+/// Elimination groups of the mixed unknowns (see `SparsePattern::groups`): a node's
+/// displacements and the multipliers of its contact pairs form one group (the node's
+/// index), so that a factorization without pivoting eliminates a multiplier, whose own
+/// pivot is zero in stick, after its node's displacements; any other unknown (a tool
+/// offset) is alone.
+pub fn elimination_groups(model: &Model, dofs: &DofMap) -> Vec<usize> {
+    let mut groups: Vec<usize> = (0..dofs.n_dofs).map(|d| dofs.n_nodes + d).collect();
+    for (d, g) in groups.iter_mut().enumerate().take(3 * dofs.n_nodes) {
+        *g = d / 3;
+    }
+    for (c, contact) in model.contacts.iter().enumerate() {
+        let Some(off) = dofs.lambda_offset[c] else {
+            continue;
+        };
+        for (k, &node) in contact.candidates.iter().enumerate() {
+            groups[off + 3 * k..off + 3 * k + 3].fill(node);
+        }
+    }
+    groups
+}
+
 /// A pair whose multiplier is eliminated.
 #[derive(Clone, Debug)]
 struct Eliminated {
@@ -165,7 +186,14 @@ impl Condenser {
         };
         let e_l_position = positions(&|e, a| 3 * e.node + a, &|e, b| e.lambda + b);
         let e_x_position = positions(&|e, a| e.lambda + a, &|e, b| 3 * e.node + b);
-        let pattern = Arc::new(SparsePattern::from_entries(next, entries));
+        let full_groups = elimination_groups(model, dofs);
+        let mut groups = vec![0; next];
+        for (d, ri) in reduced_index.iter().enumerate() {
+            if let Some(ri) = ri {
+                groups[*ri] = full_groups[d];
+            }
+        }
+        let pattern = Arc::new(SparsePattern::from_entries(next, entries).with_groups(groups));
         if pattern.nnz() > u32::MAX as usize {
             return None;
         }

@@ -16,6 +16,8 @@ pub mod simulation;
 pub mod slots;
 pub mod sparse;
 pub mod step_control;
+pub mod symmetric_lu;
+pub mod system_dump;
 
 pub use model::{Model, SolverSettings};
 pub use energy::EnergyBalance;

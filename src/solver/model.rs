@@ -64,6 +64,8 @@ pub struct SolverSettings {
     /// Eliminate the multipliers of single-pair, unconstrained contact nodes before the
     /// linear solve (same Newton iterates, smaller factorization; see `condense`).
     pub eliminate_multipliers: bool,
+    /// The sparse factorization of each Newton step (see `linear`).
+    pub linear_solver: super::linear::LinearSolverKind,
     /// Small strain (B-bar hexahedra, the default) or finite strain (total-Lagrangian
     /// F-bar hexahedra, Lagrangian log-strain material update).
     pub kinematics: crate::element::StrainTheory,
@@ -92,6 +94,7 @@ impl Default for SolverSettings {
             max_cutbacks: 4,
             contact: ContactSettings::default(),
             eliminate_multipliers: true,
+            linear_solver: Default::default(),
             kinematics: crate::element::StrainTheory::Small,
             fbar: true,
             stepping: Default::default(),

@@ -5,7 +5,7 @@
 use super::assembly::{Evaluation, FrozenFrame, PhaseTimes};
 use super::cycling::{CyclingMonitor, CyclingNode};
 use super::force_control;
-use super::linear::{FaerLu, LinearSolver};
+use super::linear::LinearSolver;
 use super::simulation::Simulation;
 use crate::contact::FrameUpdate;
 use crate::{Error, Result};
@@ -41,7 +41,7 @@ pub(super) struct Trial {
 
 impl Simulation {
     /// Solves J dx = -R, through the condensed system when multipliers are eliminated.
-    pub fn newton_step(&self, eval: &Evaluation, linear: &mut FaerLu) -> Result<Vec<f64>> {
+    pub fn newton_step(&self, eval: &Evaluation, linear: &mut dyn LinearSolver) -> Result<Vec<f64>> {
         // Tool offsets couple to every node of their tool: kept out of the sparse LU.
         let border: Vec<usize> = self.dofs.tool_offset.iter().flatten().copied().collect();
         match &self.condenser {
@@ -130,7 +130,7 @@ impl Simulation {
     }
 
 
-    pub(super) fn newton(&self, t_new: f64, linear: &mut FaerLu) -> Result<Trial> {
+    pub(super) fn newton(&self, t_new: f64, linear: &mut dyn LinearSolver) -> Result<Trial> {
         let settings = self.model.settings.clone();
         let step = &settings.stepping;
         let mut x = self.x.clone();

@@ -3,7 +3,7 @@
 //! spread over the body by one tangent solve).
 
 use super::assembly::{IncrementContext, PhaseTimes};
-use super::linear::FaerLu;
+use super::linear::LinearSolver;
 use super::simulation::Simulation;
 use crate::Result;
 use std::time::Instant;
@@ -33,7 +33,7 @@ impl Simulation {
         ctx: &IncrementContext<'_>,
         t_new: f64,
         x: &mut [f64],
-        linear: &mut FaerLu,
+        linear: &mut dyn LinearSolver,
         times: &mut PhaseTimes,
     ) -> Result<()> {
         let jumps: Vec<(usize, f64)> = self

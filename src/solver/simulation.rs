@@ -10,7 +10,7 @@ use super::checkpoint::SavedState;
 use super::condense::Condenser;
 use super::cycling::CyclingNode;
 use super::force_control;
-use super::linear::FaerLu;
+use super::linear::{LinearSolver, Solver};
 use super::model::Model;
 use super::sparse::SparsePattern;
 use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
@@ -78,7 +78,7 @@ pub struct Simulation {
     pub(super) dofs: DofMap,
     pub(super) pattern: Arc<SparsePattern>,
     pub(super) is_fixed: Vec<bool>,
-    pub(super) linear: FaerLu,
+    pub(super) linear: Solver,
     pub(super) condenser: Option<Condenser>,
     /// Committed unknowns [u, lambda].
     pub(super) x: Vec<f64>,
@@ -120,7 +120,8 @@ impl Simulation {
         }
         force_control::check(&model)?;
         let dofs = DofMap::new(&model);
-        let pattern = Arc::new(dofs.pattern(&model));
+        let groups = super::condense::elimination_groups(&model, &dofs);
+        let pattern = Arc::new(dofs.pattern(&model).with_groups(groups));
         let mut is_fixed = vec![false; dofs.n_dofs];
         for bc in &model.dirichlet {
             for &node in &bc.nodes {
@@ -170,7 +171,7 @@ impl Simulation {
             dofs,
             pattern,
             is_fixed,
-            linear: FaerLu::default(),
+            linear: Solver::new(model.settings.linear_solver),
             points,
             contact,
             time: 0.0,
@@ -298,7 +299,7 @@ impl Simulation {
 
     /// How many symbolic LU analyses were done: one per sparsity pattern, not per iteration.
     pub fn symbolic_analyses(&self) -> usize {
-        self.linear.symbolic_count
+        self.linear.symbolic_analyses()
     }
 
     /// Committed unknowns [u, lambda].
@@ -693,6 +694,9 @@ impl Simulation {
             ));
         }
         settings.stepping.validate(settings.end_time)?;
+        if settings.linear_solver != old.linear_solver {
+            self.linear = Solver::new(settings.linear_solver);
+        }
         let (lo, hi) = (
             settings.stepping.dt_min(settings.end_time),
             settings.stepping.dt_max(settings.end_time),

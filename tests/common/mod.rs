@@ -119,16 +119,20 @@ pub fn jacobian_column_errors(
         .collect()
 }
 
-/// The Newton step J dx = -R solved on the full mixed system and through the simulation's
-/// condensation, and the largest entry and largest difference.
+/// The Newton step J dx = -R solved on the full mixed system (faer's pivoting LU) and
+/// through the simulation's condensation (the default solver, LU without pivoting on the
+/// symmetric structure, which must not have needed its pivoting fallback), and the largest
+/// entry and largest difference.
 pub fn full_and_condensed_steps(
     sim: &tribo::solver::Simulation,
     e: &tribo::solver::assembly::Evaluation,
 ) -> (Vec<f64>, Vec<f64>, f64, f64) {
-    use tribo::solver::linear::{FaerLu, LinearSolver};
+    use tribo::solver::linear::{FaerLu, LinearSolver, SymmetricLu};
     let mut full: Vec<f64> = e.residual.iter().map(|v| -v).collect();
     FaerLu::default().solve(&e.jacobian, &mut full).unwrap();
-    let condensed = sim.newton_step(e, &mut FaerLu::default()).unwrap();
+    let mut solver = SymmetricLu::default();
+    let condensed = sim.newton_step(e, &mut solver).unwrap();
+    assert_eq!(solver.fallback_count, 0, "no pivot refused");
     let scale = full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let diff = full
         .iter()
