@@ -12,6 +12,7 @@
 // read like the formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bench;
 pub mod contact;
 pub mod element;
 pub mod error;

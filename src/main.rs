@@ -50,6 +50,32 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Speed table of standard cases (whole runs as child processes), optionally side by
+    /// side with another tribo binary: tribo bench --case cup --cells 25 --travel 5
+    /// --baseline OTHER_TRIBO.
+    Bench {
+        /// cup (paper variant), cup-benchmark, drag, or all; repeat for several.
+        #[arg(long, default_value = "cup")]
+        case: Vec<String>,
+        /// Cells per blank edge (cup, default 25) or along the block (drag, default 32).
+        #[arg(long)]
+        cells: Option<usize>,
+        /// Cells through the sheet (cup; default 1).
+        #[arg(long)]
+        layers: Option<usize>,
+        /// Punch travel in mm (cup; default the variant's own).
+        #[arg(long)]
+        travel: Option<f64>,
+        /// Another tribo binary to run on the same cases, side by side.
+        #[arg(long)]
+        baseline: Option<PathBuf>,
+        /// Also write the table as JSON to this file.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Folder for the scripts and the runs' outputs (default: under the system temp).
+        #[arg(long)]
+        work_dir: Option<PathBuf>,
+    },
     /// Interactive stepping; loads SCRIPT's scene first if given.
     Repl {
         script: Option<PathBuf>,
@@ -120,6 +146,28 @@ fn main() -> ExitCode {
             opts.progress = !quiet;
             tribo::study::run(&name, &opts)
         }
+        Command::Bench {
+            case,
+            cells,
+            layers,
+            travel,
+            baseline,
+            json,
+            work_dir,
+        } => (|| {
+            let opts = tribo::bench::BenchOptions {
+                cases: case,
+                cells,
+                layers,
+                travel,
+                baseline,
+                json,
+                work_dir,
+            };
+            let this = std::env::current_exe()
+                .map_err(|e| tribo::Error::Input(format!("bench: own binary: {e}")))?;
+            tribo::bench::run(&opts, &this).map(|_| ())
+        })(),
         Command::Repl {
             script,
             out,

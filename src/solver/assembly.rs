@@ -441,7 +441,9 @@ impl IncrementContext<'_> {
                             jac.values[pair_slots[2][ij]] += result.suppl_x[(i, j)];
                             jac.values[pair_slots[3][ij]] += result.suppl_lambda[(i, j)];
                         }
-                        force_control::add_node_column(&mut jac, model, self.dofs, c, node, l, &result);
+                        force_control::add_node_column(
+                            &mut jac, model, self.dofs, c, node, l, &result,
+                        );
                     }
                 }
                 list.push((result, proj));
@@ -591,9 +593,8 @@ mod tests {
         tool.schedule = Schedule::new(vec![(0.0, Vec3::zeros()), (1.0, Vec3::zeros())]).unwrap();
         tool.friction = FrictionLaw::coulomb(0.2).unwrap();
         if force_controlled {
-            tool.force_control = Some(
-                ForceControl::new(-Vec3::z(), ScalarSchedule::constant(50.0)).unwrap(),
-            );
+            tool.force_control =
+                Some(ForceControl::new(-Vec3::z(), ScalarSchedule::constant(50.0)).unwrap());
         }
         model.add_tool(tool, "z+", None).unwrap();
         model
@@ -666,7 +667,10 @@ mod tests {
             let residual_only = ctx.evaluate_residual(&x, &mut times).unwrap();
             let statuses: Vec<ContactStatus> =
                 full.nodal[0].iter().map(|(r, _)| r.status).collect();
-            assert!(statuses.iter().any(|s| s.is_active()), "contact must be active");
+            assert!(
+                statuses.iter().any(|s| s.is_active()),
+                "contact must be active"
+            );
             assert!(
                 full.trial_points.iter().any(|p| p.eq_plastic_strain > 0.0),
                 "the strip must yield"
@@ -676,11 +680,17 @@ mod tests {
             assert_eq!(bits(&full.residual), bits(&residual_only.residual));
             assert_eq!(bits(&full.f_int), bits(&residual_only.f_int));
             assert_eq!(bits(&full.f_ext), bits(&residual_only.f_ext));
-            assert_eq!(bits(&full.support_forces), bits(&residual_only.support_forces));
+            assert_eq!(
+                bits(&full.support_forces),
+                bits(&residual_only.support_forces)
+            );
             assert_eq!(full.trial_points, residual_only.trial_points);
             assert_eq!(
                 statuses,
-                residual_only.nodal[0].iter().map(|(r, _)| r.status).collect::<Vec<_>>()
+                residual_only.nodal[0]
+                    .iter()
+                    .map(|(r, _)| r.status)
+                    .collect::<Vec<_>>()
             );
         }
     }
