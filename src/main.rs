@@ -95,12 +95,33 @@ struct Limits {
     /// Largest file a script may read, in MiB.
     #[arg(long = "max-read-mb", value_name = "MIB", default_value_t = 64)]
     max_read_mb: u64,
+    /// Memory the run may use, in MiB (default: half the machine's memory). A mesh whose
+    /// estimated need is larger is refused before it is built.
+    #[arg(long = "max-memory-mb", value_name = "MIB")]
+    max_memory_mb: Option<u64>,
+    /// Wall time of the script's own code, in seconds (time in the simulation not counted).
+    #[arg(long = "max-script-seconds", value_name = "S", default_value_t = 600)]
+    max_script_seconds: u64,
+    /// Increments one simulation may take.
+    #[arg(long = "max-increments", value_name = "N", default_value_t = 100_000)]
+    max_increments: usize,
+    /// Bytes the run may write into its output folder, in MiB.
+    #[arg(long = "max-output-mb", value_name = "MIB", default_value_t = 20_480)]
+    max_output_mb: u64,
 }
 
 impl Limits {
     fn apply(&self, host: &mut HostOptions) {
         host.allow_read = self.allow_read.clone();
         host.max_read_bytes = self.max_read_mb.saturating_mul(1 << 20);
+        let l = &mut host.limits;
+        if let Some(mb) = self.max_memory_mb {
+            l.max_memory = mb.saturating_mul(1 << 20);
+        }
+        l.max_script_time = std::time::Duration::from_secs(self.max_script_seconds);
+        l.max_increments = self.max_increments;
+        l.max_output = self.max_output_mb.saturating_mul(1 << 20);
+        tribo::paths::set_output_limit(l.max_output);
     }
 }
 
@@ -181,7 +202,8 @@ fn main() -> ExitCode {
             limits.apply(&mut host);
             host.interrupt
                 .install_signal_handlers()
-                .and_then(|()| script::repl::run(script.as_deref(), &host))
+                .and_then(|()| tribo::output::FolderLock::acquire(&host.out_dir))
+                .and_then(|_lock| script::repl::run(script.as_deref(), &host))
         }
     };
     match result {

@@ -17,8 +17,11 @@
 //!   `max_bytes` are read. Error messages name the path the script gave, never file contents.
 
 use crate::{Error, Result};
+use std::collections::{BTreeMap, HashMap};
 use std::io::Read;
 use std::path::{Component, Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 /// Default cap on a file a script reads (JSON tables, modules): 64 MiB.
 pub const DEFAULT_MAX_READ_BYTES: u64 = 64 << 20;
@@ -92,7 +95,63 @@ pub fn resolve_write(root: &Path, relative: &str, create_parents: bool) -> Resul
             Err(e) => return Err(Error::io(&path, e)),
         }
     }
+    if create_parents {
+        charge_output(root, &path)?;
+    }
     Ok(path)
+}
+
+/// Bytes a run may write into its output folder ([`set_output_limit`]).
+static OUTPUT_LIMIT: AtomicU64 = AtomicU64::new(u64::MAX);
+
+/// Per output folder: the files handed out for writing and their sizes when last looked at.
+#[derive(Default)]
+struct Ledger {
+    sizes: HashMap<PathBuf, u64>,
+    /// Files that may still grow, with how many refreshes they have stayed the same size.
+    watch: Vec<(PathBuf, u32)>,
+    total: u64,
+}
+
+static LEDGERS: Mutex<BTreeMap<PathBuf, Ledger>> = Mutex::new(BTreeMap::new());
+
+/// Caps the bytes a run writes into its output folder (`--max-output-mb`). Counted by
+/// [`resolve_write`] when it hands out the next path: files written since the last call (and
+/// files still growing, like history.csv) are measured, so the run stops at the first write
+/// after the cap, with at most one file's worth written over it.
+pub fn set_output_limit(bytes: u64) {
+    OUTPUT_LIMIT.store(bytes, Ordering::Relaxed);
+}
+
+/// Measures the files written since the last call and refuses a new write once over the cap.
+/// Cost: one `lstat` per file written or grown since the last call (a file that stays the
+/// same size for 8 calls is no longer watched).
+fn charge_output(root: &Path, next: &Path) -> Result<()> {
+    let limit = OUTPUT_LIMIT.load(Ordering::Relaxed);
+    let mut ledgers = LEDGERS.lock().unwrap_or_else(|e| e.into_inner());
+    let ledger = ledgers.entry(root.to_path_buf()).or_default();
+    let mut watch = std::mem::take(&mut ledger.watch);
+    watch.retain_mut(|(path, same)| {
+        let size = std::fs::symlink_metadata(&*path).map_or(0, |m| m.len());
+        let old = ledger.sizes.insert(path.clone(), size).unwrap_or(0);
+        ledger.total = ledger.total - old.min(ledger.total) + size;
+        *same = if size == old { *same + 1 } else { 0 };
+        *same < 8
+    });
+    ledger.watch = watch;
+    if ledger.total > limit {
+        return Err(Error::Input(format!(
+            "the run has written {} bytes into its output folder {}, over the limit of {} bytes \
+             (raise it with --max-output-mb)",
+            ledger.total,
+            root.display(),
+            limit
+        )));
+    }
+    if !ledger.watch.iter().any(|(p, _)| p == next) {
+        ledger.watch.push((next.to_path_buf(), 0));
+    }
+    Ok(())
 }
 
 /// Opens (creating or truncating) a file checked by [`resolve_write`], refusing a link that

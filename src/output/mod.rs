@@ -21,7 +21,7 @@ mod vtk;
 pub mod run;
 
 pub use self::csv::HistoryCsv;
-pub use self::folder::OutputFolder;
+pub use self::folder::{FolderLock, OutputFolder, LOCK_FILE};
 pub use self::pvd::{PvdEntry, PvdSeries};
 pub use self::run::RunOutput;
 pub use self::summary::{write_summary, SUMMARY_FILE};

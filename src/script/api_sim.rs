@@ -45,7 +45,17 @@ type NodeSnapshot = (usize, f64, Vec<Vec<[f64; 3]>>);
 /// One increment with script friction laws applied: the simulation is not borrowed while
 /// a script function runs (it may itself query the simulation).
 fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementReport> {
-    let report = s.borrow_mut().step_once()?;
+    let (done, cap, clock) = {
+        let st = s.borrow();
+        let done = st.sim.as_ref().map_or(0, |x| x.history.len());
+        (done, st.host.limits.max_increments, st.host.clock.clone())
+    };
+    if done >= cap {
+        return runtime_error(format!(
+            "the simulation has taken {done} increments, the limit (raise it with --max-increments)"
+        ));
+    }
+    let report = clock.exclude(|| s.borrow_mut().step_once())?;
     let pending: Vec<(usize, FnPtr, Vec<FrictionInput>)> = {
         let st = s.borrow();
         let sim = st.sim.as_ref().expect("started");
@@ -468,6 +478,8 @@ pub(super) fn interrupted(why: &str) -> Box<rhai::EvalAltResult> {
 struct Knobs {
     output_every: usize,
     checkpoint_every: usize,
+    /// `--max-increments`: a larger `increments` setting is refused.
+    max_increments: usize,
 }
 
 fn choice<'a>(v: &Dynamic, key: &str, options: &[&'a str]) -> ScriptResult<&'a str> {
@@ -529,10 +541,24 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             "cycle_flips" => step.cycle_flips = count(key)?,
             "rollback_depth" => step.rollback_depth = count(key)?,
             "checkpoint_every" => st.checkpoint_every = count(key)?,
-            "increments" => s.increments = num("increments")? as usize,
+            "increments" => {
+                let n = number(v, key)?;
+                let cap = st.max_increments as f64;
+                if !(n >= 1.0 && n <= cap && n.fract() == 0.0) {
+                    return fail(Error::input(
+                        key,
+                        n,
+                        &format!(
+                            "must be a whole number from 1 to {} (raise the cap with --max-increments)",
+                            st.max_increments
+                        ),
+                    ));
+                }
+                s.increments = n as usize;
+            }
             "end_time" => s.end_time = num("end_time")?,
-            "max_iterations" => s.max_iterations = num("max_iterations")? as usize,
-            "max_cutbacks" => s.max_cutbacks = num("max_cutbacks")? as usize,
+            "max_iterations" => s.max_iterations = count(key)?,
+            "max_cutbacks" => s.max_cutbacks = count(key)?,
             "force_tolerance" => s.force_rel_tol = num("force_tolerance")?,
             "force_abs_tolerance" => s.force_abs_tol = num("force_abs_tolerance")?,
             "contact_tolerance" => s.contact_tol = num("contact_tolerance")?,
@@ -630,6 +656,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             let mut knobs = Knobs {
                 output_every: 1,
                 checkpoint_every: 0,
+                max_increments: h.limits.max_increments,
             };
             apply_settings(&mut model.settings, &mut knobs, &h.base_settings)?;
             let sim = Rc::new(RefCell::new(SimState {
@@ -707,6 +734,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             let mut knobs = Knobs {
                 output_every: st.output_every,
                 checkpoint_every: st.checkpoint_every,
+                max_increments: st.host.limits.max_increments,
             };
             if let Some(model) = st.model.as_mut() {
                 apply_settings(&mut model.settings, &mut knobs, &spec)?;

@@ -9,6 +9,7 @@ mod api_scene;
 mod api_sim;
 mod api_tools;
 mod convert;
+pub mod limits;
 pub mod repl;
 mod stdlib;
 
@@ -55,6 +56,10 @@ pub struct HostOptions {
     pub allow_read: Vec<PathBuf>,
     /// Largest file a script may read (imports, JSON tables), in bytes.
     pub max_read_bytes: u64,
+    /// Memory, script time, increments and output size ([`limits`]).
+    pub limits: limits::Limits,
+    /// The script's own time (the engine sets a fresh one).
+    pub clock: Rc<limits::ScriptClock>,
 }
 
 impl Default for HostOptions {
@@ -74,6 +79,8 @@ impl Default for HostOptions {
             simulations: Simulations::default(),
             allow_read: Vec::new(),
             max_read_bytes: crate::paths::DEFAULT_MAX_READ_BYTES,
+            limits: limits::Limits::default(),
+            clock: Rc::default(),
         }
     }
 }
@@ -92,7 +99,13 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     if !host.script_print {
         engine.on_print(|_| {});
     }
-    let host = Rc::new(host.clone());
+    let mut host = host.clone();
+    host.clock = Rc::default();
+    let (limits, clock) = (host.limits.clone(), host.clock.clone());
+    engine.on_progress(move |ops| {
+        limits::progress_check(&limits, &clock, ops).map(Dynamic::from)
+    });
+    let host = Rc::new(host);
     api_scene::register(&mut engine, host.clone());
     api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
@@ -149,11 +162,26 @@ fn register_checks(engine: &mut Engine) {
 /// another source (a std-lib module) is reported where this file called it.
 pub fn describe_error(file: &str, err: &EvalAltResult) -> String {
     let pos = innermost_position(file, err);
-    let msg = err.to_string();
+    let msg = message(err);
     match (pos.line(), pos.position()) {
         (Some(l), Some(c)) => format!("{file}:{l}:{c}: {msg}"),
         (Some(l), None) => format!("{file}:{l}: {msg}"),
         _ => format!("{file}: {msg}"),
+    }
+}
+
+/// The message of an error, with a limit's own text for a script the progress check stopped.
+fn message(err: &EvalAltResult) -> String {
+    match err {
+        EvalAltResult::ErrorTerminated(why, _) => format!("stopped: {why}"),
+        EvalAltResult::ErrorInFunctionCall(_, _, inner, _) => {
+            if let EvalAltResult::ErrorTerminated(..) = &**inner {
+                message(inner)
+            } else {
+                err.to_string()
+            }
+        }
+        other => other.to_string(),
     }
 }
 
@@ -223,9 +251,12 @@ pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
 /// checkpoint that no simulation used is an error.
 pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions) -> Result<()> {
     host.simulations.clear();
-    read_policy(host, path.parent())?;
     let engine = engine(host, path.parent());
     let ast = compile(&engine, path)?;
+    // The --allow-read folders exist (the engine would otherwise refuse every read quietly).
+    read_policy(host, path.parent())?;
+    // Held to the end of the run: a second run into the same folder is refused.
+    let _lock = crate::output::FolderLock::acquire(&host.out_dir)?;
     let ast = apply_overrides(&engine, ast, overrides, path)?;
     let mut scope = Scope::new();
     let outcome = engine
