@@ -15,6 +15,9 @@ pub enum Error {
     /// Newton did not converge; every converged frame written so far is kept.
     #[error("no convergence: {0}")]
     NoConvergence(String),
+    /// The run was asked to stop (a signal): the last converged state is kept.
+    #[error("interrupted: {0}")]
+    Interrupted(String),
     /// A file could not be read or written.
     #[error("I/O error on {path}: {message}")]
     Io { path: String, message: String },

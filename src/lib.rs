@@ -12,13 +12,16 @@
 // read like the formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bench;
 pub mod contact;
 pub mod element;
 pub mod error;
 pub mod geometry;
+pub mod interrupt;
 pub mod material;
 pub mod mesh;
 pub mod output;
+pub mod paths;
 pub mod script;
 pub mod solver;
 pub mod study;

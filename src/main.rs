@@ -35,6 +35,8 @@ enum Command {
         /// or at a stop): the script builds the model again, then the state is loaded.
         #[arg(long, value_name = "CHECKPOINT")]
         restart: Option<PathBuf>,
+        #[command(flatten)]
+        limits: Limits,
     },
     /// Speed against accuracy: work-precision charts and stability maps with a report.
     Study {
@@ -48,12 +50,79 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Speed table of standard cases (whole runs as child processes), optionally side by
+    /// side with another tribo binary: tribo bench --case cup --cells 25 --travel 5
+    /// --baseline OTHER_TRIBO.
+    Bench {
+        /// cup (paper variant), cup-benchmark, drag, or all; repeat for several.
+        #[arg(long, default_value = "cup")]
+        case: Vec<String>,
+        /// Cells per blank edge (cup, default 25) or along the block (drag, default 32).
+        #[arg(long)]
+        cells: Option<usize>,
+        /// Cells through the sheet (cup; default 1).
+        #[arg(long)]
+        layers: Option<usize>,
+        /// Punch travel in mm (cup; default the variant's own).
+        #[arg(long)]
+        travel: Option<f64>,
+        /// Another tribo binary to run on the same cases, side by side.
+        #[arg(long)]
+        baseline: Option<PathBuf>,
+        /// Also write the table as JSON to this file.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Folder for the scripts and the runs' outputs (default: under the system temp).
+        #[arg(long)]
+        work_dir: Option<PathBuf>,
+    },
     /// Interactive stepping; loads SCRIPT's scene first if given.
     Repl {
         script: Option<PathBuf>,
         #[arg(long)]
         out: Option<PathBuf>,
+        #[command(flatten)]
+        limits: Limits,
     },
+}
+
+/// What a script may read and how much the run may use (see docs/script-api.md, "Limits").
+#[derive(clap::Args)]
+struct Limits {
+    /// A folder scripts may read besides their own (imports, JSON tables); repeatable.
+    #[arg(long = "allow-read", value_name = "DIR")]
+    allow_read: Vec<PathBuf>,
+    /// Largest file a script may read, in MiB.
+    #[arg(long = "max-read-mb", value_name = "MIB", default_value_t = 64)]
+    max_read_mb: u64,
+    /// Memory the run may use, in MiB (default: half the machine's memory). A mesh whose
+    /// estimated need is larger is refused before it is built.
+    #[arg(long = "max-memory-mb", value_name = "MIB")]
+    max_memory_mb: Option<u64>,
+    /// Wall time of the script's own code, in seconds (time in the simulation not counted).
+    #[arg(long = "max-script-seconds", value_name = "S", default_value_t = 600)]
+    max_script_seconds: u64,
+    /// Increments one simulation may take.
+    #[arg(long = "max-increments", value_name = "N", default_value_t = 100_000)]
+    max_increments: usize,
+    /// Bytes the run may write into its output folder, in MiB.
+    #[arg(long = "max-output-mb", value_name = "MIB", default_value_t = 20_480)]
+    max_output_mb: u64,
+}
+
+impl Limits {
+    fn apply(&self, host: &mut HostOptions) {
+        host.allow_read = self.allow_read.clone();
+        host.max_read_bytes = self.max_read_mb.saturating_mul(1 << 20);
+        let l = &mut host.limits;
+        if let Some(mb) = self.max_memory_mb {
+            l.max_memory = mb.saturating_mul(1 << 20);
+        }
+        l.max_script_time = std::time::Duration::from_secs(self.max_script_seconds);
+        l.max_increments = self.max_increments;
+        l.max_output = self.max_output_mb.saturating_mul(1 << 20);
+        tribo::paths::set_output_limit(l.max_output);
+    }
 }
 
 fn default_out(script: Option<&PathBuf>) -> PathBuf {
@@ -73,17 +142,20 @@ fn main() -> ExitCode {
             set,
             quiet,
             restart,
+            limits,
         } => (|| {
             let overrides = set
                 .iter()
                 .map(|s| script::parse_override(s))
                 .collect::<tribo::Result<Vec<_>>>()?;
-            let host = HostOptions {
+            let mut host = HostOptions {
                 out_dir: out.unwrap_or_else(|| default_out(Some(&script))),
                 progress: !quiet,
                 restart,
                 ..HostOptions::default()
             };
+            host.interrupt.install_signal_handlers()?;
+            limits.apply(&mut host);
             script::run_file(&script, &overrides, &host)?;
             eprintln!("results in {}", host.out_dir.display());
             Ok(())
@@ -95,17 +167,51 @@ fn main() -> ExitCode {
             opts.progress = !quiet;
             tribo::study::run(&name, &opts)
         }
-        Command::Repl { script, out } => {
-            let host = HostOptions {
+        Command::Bench {
+            case,
+            cells,
+            layers,
+            travel,
+            baseline,
+            json,
+            work_dir,
+        } => (|| {
+            let opts = tribo::bench::BenchOptions {
+                cases: case,
+                cells,
+                layers,
+                travel,
+                baseline,
+                json,
+                work_dir,
+            };
+            let this = std::env::current_exe()
+                .map_err(|e| tribo::Error::Input(format!("bench: own binary: {e}")))?;
+            tribo::bench::run(&opts, &this).map(|_| ())
+        })(),
+        Command::Repl {
+            script,
+            out,
+            limits,
+        } => {
+            let mut host = HostOptions {
                 out_dir: out.unwrap_or_else(|| default_out(script.as_ref())),
                 progress: true,
                 ..HostOptions::default()
             };
-            script::repl::run(script.as_deref(), &host)
+            limits.apply(&mut host);
+            host.interrupt
+                .install_signal_handlers()
+                .and_then(|()| tribo::output::FolderLock::acquire(&host.out_dir))
+                .and_then(|_lock| script::repl::run(script.as_deref(), &host))
         }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e @ tribo::Error::Interrupted(_)) => {
+            eprintln!("{e}: the last converged state and summary.json are in the output folder");
+            ExitCode::from(tribo::interrupt::EXIT_INTERRUPTED)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE

@@ -104,6 +104,10 @@ fn large_slip_across_many_seams_converges_without_chattering() {
         // 3 press increments, then 6 drag increments of 1 mm (about 4 patch widths).
         m.settings.increments = 9;
         m.settings.max_cutbacks = 0;
+        // From the committed state, and r as this test was written with (see
+        // `former_default_r`), so that each increment has iterations to show a rate.
+        m.settings.extrapolate = false;
+        common::former_default_r(&mut m, 0, 0.3, 0.5, 0.5);
         m.settings.force_rel_tol = 1e-11;
         m.settings.contact_tol = 1e-11;
         if bezier {

@@ -3,6 +3,7 @@
 
 mod common;
 
+use tribo::solver::linear::{FaerLu, LinearSolverKind, SymmetricLu};
 use tribo::solver::Simulation;
 
 fn drag(eliminate: bool) -> Simulation {
@@ -30,6 +31,31 @@ fn condensed_newton_step_equals_the_mixed_one() {
     assert!(diff < 1e-10 * scale, "condensed step differs by {diff:e}");
 }
 
+/// The slot plan places every contribution where a search in the pattern would: the reduced
+/// matrix and right-hand side are bitwise those of the search-based construction (same
+/// contributions, summed in the same order).
+#[test]
+fn slot_plan_builds_the_reduced_system_of_the_search() {
+    let mut sim = drag(true);
+    for _ in 0..6 {
+        sim.step().unwrap();
+    }
+    let t_new = sim.time() + 0.25;
+    let x = sim.unknowns().to_vec();
+    let e = sim.evaluate_at(t_new, &x).unwrap();
+    let condenser = sim.condenser().expect("multipliers are eliminated");
+    let (a, rhs) = condenser.reduced_system(&e.jacobian, &e.residual);
+    let (a_ref, rhs_ref) = condenser.reduced_system_by_search(&e.jacobian, &e.residual);
+    assert!(a.values.iter().any(|v| *v != 0.0));
+    assert_eq!(a.pattern, a_ref.pattern);
+    for (k, (v, w)) in a.values.iter().zip(&a_ref.values).enumerate() {
+        assert_eq!(v.to_bits(), w.to_bits(), "value {k}: {v} vs {w}");
+    }
+    for (k, (v, w)) in rhs.iter().zip(&rhs_ref).enumerate() {
+        assert_eq!(v.to_bits(), w.to_bits(), "right-hand side {k}: {v} vs {w}");
+    }
+}
+
 #[test]
 fn condensed_and_mixed_runs_agree() {
     let mut a = drag(true);
@@ -49,4 +75,72 @@ fn condensed_and_mixed_runs_agree() {
     );
     assert!(d < 1e-9, "runs differ by {d}");
     assert_eq!(iters(&a), iters(&b));
+}
+
+/// The plane-strain drag (y faces fixed: the roller's nodes have a prescribed component and
+/// keep their multipliers, which the factorization without pivoting eliminates after their
+/// node's displacements: the mixed system) and the free drag (multipliers condensed).
+fn drag_with(free_y: bool, solver: LinearSolverKind) -> Simulation {
+    let mut model = common::cylinder_drag_model(16.0, 4.0, 32, 8.0);
+    model.settings.increments = 12;
+    if free_y {
+        model.dirichlet.retain(|d| !d.label.starts_with('y'));
+    }
+    model.settings.linear_solver = solver;
+    Simulation::new(model).unwrap()
+}
+
+/// The same Newton steps from the LU without pivoting on the symmetric structure as from
+/// faer's pivoting LU, on the reduced system with kept multipliers (gap, stick and slip
+/// statuses, pressing then dragging), without the pivoting fallback.
+#[test]
+fn symmetric_lu_steps_equal_the_pivoting_lu_steps() {
+    for free_y in [false, true] {
+        let mut sim = drag_with(free_y, LinearSolverKind::SymmetricLu);
+        for steps in [2, 4] {
+            for _ in 0..steps {
+                sim.step().unwrap();
+            }
+            let t_new = sim.time() + 0.25;
+            let mut x = sim.unknowns().to_vec();
+            for _ in 0..3 {
+                let e = sim.evaluate_at(t_new, &x).unwrap();
+                let old = sim.newton_step(&e, &mut FaerLu::default()).unwrap();
+                let mut symmetric = SymmetricLu::default();
+                let new = sim.newton_step(&e, &mut symmetric).unwrap();
+                assert_eq!(symmetric.fallback_count, 0);
+                let scale = old.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let diff = old
+                    .iter()
+                    .zip(&new)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                println!("free y {free_y}, t {t_new}: step {scale:.3e}, difference {diff:.3e}");
+                // Two factorizations of one system: round-off times the condition number.
+                assert!(diff < 1e-10 * scale, "steps differ by {diff:e}");
+                for (xi, d) in x.iter_mut().zip(&new) {
+                    *xi += d;
+                }
+            }
+        }
+    }
+}
+
+/// Whole runs with either solver: the same iterations, the same converged unknowns up to
+/// Newton's tolerance.
+#[test]
+fn symmetric_lu_and_pivoting_lu_runs_agree() {
+    let mut a = drag_with(false, LinearSolverKind::SymmetricLu);
+    let mut b = drag_with(false, LinearSolverKind::Lu);
+    a.run(|_, _| Ok(())).unwrap();
+    b.run(|_, _| Ok(())).unwrap();
+    let scale = b.unknowns().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let d = a
+        .unknowns()
+        .iter()
+        .zip(b.unknowns())
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let iters = |s: &Simulation| s.history.iter().map(|r| r.iterations).collect::<Vec<_>>();
+    println!("max difference {d:.2e} of {scale:.2e}");
+    assert_eq!(iters(&a), iters(&b));
+    assert!(d < 1e-9 * scale, "runs differ by {d}");
 }

@@ -22,6 +22,8 @@ fn drag_model(curvature: bool) -> Model {
     model.settings.force_rel_tol = 1e-11;
     model.settings.contact_tol = 1e-11;
     model.settings.contact.curvature = curvature;
+    // r as this test was written with (see `former_default_r`): 0.5 x 1 x 0.5 cells.
+    common::former_default_r(&mut model, 0, 0.3, 0.5, 0.5);
     model
 }
 

@@ -332,6 +332,9 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
     model.settings.increments = 40;
     model.settings.max_iterations = 40;
     model.settings.max_cutbacks = 0;
+    // From the committed state: the extrapolated start leaves too few iterations per
+    // increment to read an order from.
+    model.settings.extrapolate = false;
     model.settings.force_rel_tol = 1e-11;
     model.settings.contact_tol = 1e-11;
     let mut sim = Simulation::new(model).unwrap();

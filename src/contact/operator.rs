@@ -78,6 +78,9 @@ pub struct NodalContact {
     pub suppl_lambda: Mat3,
     /// Tangential slip increment delta_t at this state (for frictional work).
     pub slip_increment: Vec3,
+    /// Tangential part of F_equi (the friction force on the tool): sigma_t in stick,
+    /// -mu sigma_n t in slip, exactly zero for mu = 0 and in a gap (for frictional work).
+    pub tangential_force: Vec3,
 }
 
 /// Inputs of the nodal operator besides the geometry.
@@ -157,15 +160,16 @@ pub fn alart_curnier(
         Some(s) => s,
         None => natural,
     };
-    let (status, f_equi, equi_x, equi_lambda) = if chosen == ContactStatus::Gap {
+    let (status, f_equi, equi_x, equi_lambda, tangential_force) = if chosen == ContactStatus::Gap {
         (
             ContactStatus::Gap,
             Vec3::zeros(),
             Mat3::zeros(),
             Mat3::zeros(),
+            Vec3::zeros(),
         )
     } else if chosen == ContactStatus::Stick {
-        (ContactStatus::Stick, sigma, dsigma_x, ident)
+        (ContactStatus::Stick, sigma, dsigma_x, ident, sigma_t)
     } else {
         let st_norm = sigma_t.norm();
         let t = sigma_t / st_norm;
@@ -183,7 +187,7 @@ pub fn alart_curnier(
         let fl = n_mu_t * n.transpose()
             - dt_l * (mu * sigma_n)
             - t * params.dmu_dlambda.transpose() * sigma_n;
-        (ContactStatus::Slip, f, fx, fl)
+        (ContactStatus::Slip, f, fx, fl, -t * (mu * sigma_n))
     };
 
     NodalContact {
@@ -195,6 +199,7 @@ pub fn alart_curnier(
         suppl_x: equi_x / r,
         suppl_lambda: (equi_lambda - ident) / r,
         slip_increment: delta_t,
+        tangential_force,
     }
 }
 

@@ -20,6 +20,8 @@ use crate::{Error, Result};
 
 pub mod hex8;
 pub mod hex8_fbar;
+#[doc(hidden)]
+pub mod hex8_fbar_reference;
 
 pub use hex8::Hex8;
 pub use hex8_fbar::Hex8FBar;
@@ -115,6 +117,30 @@ pub trait Element<const D: usize>: std::fmt::Debug + Send + Sync {
         trial: &mut [PointState],
         material: &dyn Material,
     ) -> Result<ElementResponse<D>>;
+
+    /// [`evaluate`](Self::evaluate) writing straight into the caller's buffers: `force`
+    /// (length `D`) and, unless `None` (residual only), `stiffness` (length `D²`,
+    /// column-major). Both are overwritten, not accumulated. The assembly calls this one, so
+    /// that an element may skip the tangent for a residual-only evaluation and avoid moving
+    /// a `D x D` matrix by value; the default forwards to `evaluate` and copies.
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate_into(
+        &self,
+        ref_coords: &[Vec3],
+        u: &[Vec3],
+        committed: &[PointState],
+        trial: &mut [PointState],
+        material: &dyn Material,
+        force: &mut [f64],
+        stiffness: Option<&mut [f64]>,
+    ) -> Result<()> {
+        let response = self.evaluate(ref_coords, u, committed, trial, material)?;
+        force.copy_from_slice(response.force.as_slice());
+        if let Some(k) = stiffness {
+            k.copy_from_slice(response.stiffness.as_slice());
+        }
+        Ok(())
+    }
 
     /// Reference volume weight `w_g det J_g` of each integration point.
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>>;

@@ -144,9 +144,7 @@ impl ElastoPlastic {
             jac.fixed_view_mut::<6, 1>(0, 6).copy_from(&(n * e));
             jac.fixed_view_mut::<1, 6>(6, 0).copy_from(&n.transpose());
             jac[(6, 6)] = -h;
-            let step = jac
-                .lu()
-                .solve(&(-res))
+            let step = solve_dense(jac, -res)
                 .ok_or_else(|| self.failure(sig_tr, "singular return-mapping Jacobian"))?;
             // Backtracking: accept the first step length that reduces the residual norm.
             let norm = res.norm();
@@ -212,6 +210,44 @@ impl ElastoPlastic {
             sig_tr.as_slice()
         ))
     }
+}
+
+/// Solves `a x = b` by Gaussian elimination with partial pivoting, in place on the stack
+/// (the return mapping's 7 x 7 Newton system: nalgebra's generic LU spent most of the
+/// plastic point's time in bookkeeping). None when a pivot is exactly zero (singular), as
+/// nalgebra's `LU::solve`.
+fn solve_dense<const N: usize>(
+    mut a: SMatrix<f64, N, N>,
+    mut b: SVector<f64, N>,
+) -> Option<SVector<f64, N>> {
+    for col in 0..N {
+        let pivot = (col..N).max_by(|&i, &j| a[(i, col)].abs().total_cmp(&a[(j, col)].abs()))?;
+        if a[(pivot, col)] == 0.0 {
+            return None;
+        }
+        if pivot != col {
+            a.swap_rows(pivot, col);
+            b.swap_rows(pivot, col);
+        }
+        let d = a[(col, col)];
+        for row in col + 1..N {
+            let factor = a[(row, col)] / d;
+            if factor != 0.0 {
+                for c in col + 1..N {
+                    a[(row, c)] -= factor * a[(col, c)];
+                }
+                b[row] -= factor * b[col];
+            }
+        }
+    }
+    for col in (0..N).rev() {
+        let mut v = b[col];
+        for c in col + 1..N {
+            v -= a[(col, c)] * b[c];
+        }
+        b[col] = v / a[(col, col)];
+    }
+    Some(b)
 }
 
 impl Material for ElastoPlastic {
@@ -289,6 +325,28 @@ mod tests {
 
     fn swift() -> Hardening {
         Hardening::swift(500.0, 0.01, 0.22).unwrap()
+    }
+
+    /// The return mapping's dense solve against nalgebra's LU on a non-symmetric 7 x 7
+    /// system whose first column needs a row swap (pivoting); a matrix with a zero column is
+    /// None.
+    /// Agreement to 1e-12 relative (condition number ~10: round-off ~1e-15).
+    #[test]
+    fn dense_solve_matches_lu_and_detects_singularity() {
+        let a = SMatrix::<f64, 7, 7>::from_fn(|i, j| {
+            if i == 0 && j == 0 {
+                0.0
+            } else {
+                ((i * 7 + j * 3) % 11) as f64 / 11.0 + if i == j { 2.0 } else { 0.0 }
+            }
+        });
+        let b = SVector::<f64, 7>::from_fn(|i, _| i as f64 - 2.5);
+        let x = solve_dense(a, b).unwrap();
+        let y = a.lu().solve(&b).unwrap();
+        assert!((x - y).amax() < 1e-12 * y.amax(), "{x} {y}");
+        let mut singular = a;
+        singular.set_column(4, &SVector::<f64, 7>::zeros());
+        assert!(solve_dense(singular, b).is_none());
     }
 
     fn aluminium(yield_function: Hill48) -> ElastoPlastic {

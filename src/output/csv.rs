@@ -32,7 +32,7 @@ impl HistoryCsv {
         }
         let columns: Vec<String> = columns.iter().map(|c| c.as_ref().to_string()).collect();
         let header: Vec<String> = columns.iter().map(|c| quote(c)).collect();
-        let mut file = File::create(&path).map_err(|e| Error::io(&path, e))?;
+        let mut file = crate::paths::create_file(&path).map_err(|e| Error::io(&path, e))?;
         writeln!(file, "{}", header.join(","))
             .and_then(|_| file.flush())
             .map_err(|e| Error::io(&path, e))?;

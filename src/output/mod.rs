@@ -21,7 +21,7 @@ mod vtk;
 pub mod run;
 
 pub use self::csv::HistoryCsv;
-pub use self::folder::OutputFolder;
+pub use self::folder::{FolderLock, OutputFolder, LOCK_FILE};
 pub use self::pvd::{PvdEntry, PvdSeries};
 pub use self::run::RunOutput;
 pub use self::summary::{write_summary, SUMMARY_FILE};
@@ -36,7 +36,7 @@ use std::path::{Path, PathBuf};
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = temp_sibling(path)?;
     let result = (|| -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
+        let mut f = crate::paths::create_file(&tmp)?;
         f.write_all(bytes)?;
         f.flush()?;
         f.sync_data()?;

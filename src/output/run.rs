@@ -9,6 +9,18 @@ use crate::solver::{IncrementReport, Simulation};
 use crate::Result;
 use std::path::Path;
 
+/// Why and how a run stopped before its end, for summary.json.
+#[derive(Clone, Debug, Default)]
+pub struct Stop {
+    /// "stopped" (an error) or "interrupted" (a signal).
+    pub status: String,
+    pub reason: String,
+    /// Where the last converged state was saved.
+    pub final_checkpoint: Option<String>,
+    /// Files that could not be written at the stop, each with its error.
+    pub write_failures: Vec<String>,
+}
+
 pub struct RunOutput {
     folder: OutputFolder,
     pvd: PvdSeries,
@@ -22,6 +34,12 @@ pub struct RunOutput {
 impl RunOutput {
     pub fn create(dir: &Path, sim: &Simulation) -> Result<Self> {
         let folder = OutputFolder::create(dir)?;
+        for (path, pid) in remove_stale_temporaries(folder.root()) {
+            eprintln!(
+                "note: removed {}, left by process {pid} (no longer running) in the middle of a write",
+                path.display()
+            );
+        }
         let pvd = PvdSeries::new(folder.root(), "frames")?;
         let mut columns: Vec<String> = [
             "increment",
@@ -103,11 +121,19 @@ impl RunOutput {
         &self.frame_times
     }
 
-    /// Writes the committed state as a checkpoint at `relative` (below the output folder).
-    pub fn write_checkpoint(&self, sim: &Simulation, relative: &str) -> Result<std::path::PathBuf> {
+    /// Writes the committed state as a checkpoint at `relative` (below the output folder),
+    /// with the values the script keeps (`script`).
+    pub fn write_checkpoint(
+        &self,
+        sim: &Simulation,
+        relative: &str,
+        script: &serde_json::Map<String, serde_json::Value>,
+    ) -> Result<std::path::PathBuf> {
         let path = self.folder.resolve_for_write(relative)?;
-        let json =
-            crate::solver::checkpoint::Checkpoint::of(sim, self.frame_times.clone()).to_json()?;
+        let mut checkpoint =
+            crate::solver::checkpoint::Checkpoint::of(sim, self.frame_times.clone());
+        checkpoint.script = script.clone();
+        let json = checkpoint.to_json()?;
         super::write_atomic(&path, json.as_bytes())?;
         Ok(path)
     }
@@ -202,6 +228,31 @@ impl RunOutput {
         wall_time_s: f64,
         error: Option<&str>,
     ) -> Result<()> {
+        let stop = error.map(|e| Stop {
+            status: "stopped".into(),
+            reason: e.to_string(),
+            final_checkpoint: None,
+            write_failures: Vec::new(),
+        });
+        self.write_summary_of(sim, wall_time_s, stop.as_ref())
+    }
+
+    /// Writes summary.json for a run that stopped before its end (see [`Stop`]).
+    pub fn write_stop_summary(
+        &self,
+        sim: &Simulation,
+        wall_time_s: f64,
+        stop: &Stop,
+    ) -> Result<()> {
+        self.write_summary_of(sim, wall_time_s, Some(stop))
+    }
+
+    fn write_summary_of(
+        &self,
+        sim: &Simulation,
+        wall_time_s: f64,
+        stop: Option<&Stop>,
+    ) -> Result<()> {
         let tools: serde_json::Map<String, serde_json::Value> = sim
             .model
             .contacts
@@ -231,8 +282,15 @@ impl RunOutput {
         let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();
         let settings = &sim.model.settings;
         let mut summary = serde_json::json!({
-            "status": if error.is_some() { "stopped" } else if sim.is_finished() { "finished" } else { "running" },
-            "error": error,
+            "status": match stop {
+                Some(s) => s.status.as_str(),
+                None if sim.is_finished() => "finished",
+                None => "running",
+            },
+            "error": stop.filter(|s| s.status != "interrupted").map(|s| &s.reason),
+            "stop_reason": stop.map(|s| &s.reason),
+            "final_checkpoint": stop.and_then(|s| s.final_checkpoint.as_ref()),
+            "write_failures": stop.map(|s| &s.write_failures),
             "time": sim.time(),
             "end_time": settings.end_time,
             "increments": sim.history.len(),
@@ -274,6 +332,56 @@ impl RunOutput {
         }
         write_summary(&self.folder.resolve_for_write("summary.json")?, &summary)
     }
+}
+
+/// Removes the temporary files of atomic writes (`.NAME.PID.tmp`, see `write_atomic`) that
+/// a process killed in the middle of a write left in `root`, `root/frames` and
+/// `root/checkpoints`: only names of that pattern whose NAME is one of the run's own files
+/// (.json, .vtu, .pvd, .csv, .svg) and whose process is no longer running (Linux: no
+/// /proc/PID; elsewhere nothing is removed). Returns the removed files with their PIDs.
+pub fn remove_stale_temporaries(root: &Path) -> Vec<(std::path::PathBuf, u32)> {
+    let proc_fs = Path::new("/proc/self").exists();
+    let mut removed = Vec::new();
+    if !proc_fs {
+        return removed;
+    }
+    for dir in [
+        root.to_path_buf(),
+        root.join("frames"),
+        root.join("checkpoints"),
+    ] {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            let Some(pid) = name.to_str().and_then(stale_temporary_pid) else {
+                continue;
+            };
+            let running = Path::new("/proc").join(pid.to_string()).exists();
+            let is_file = entry.file_type().is_ok_and(|t| t.is_file());
+            if !running && is_file && std::fs::remove_file(entry.path()).is_ok() {
+                removed.push((entry.path(), pid));
+            }
+        }
+    }
+    removed
+}
+
+/// The PID in a name `.NAME.PID.tmp` written by `write_atomic` for one of the run's files.
+fn stale_temporary_pid(name: &str) -> Option<u32> {
+    let inner = name.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let (target, pid) = inner.rsplit_once('.')?;
+    if pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let ours = [".json", ".vtu", ".pvd", ".csv", ".svg"]
+        .iter()
+        .any(|ext| target.len() > ext.len() && target.ends_with(ext));
+    if !ours {
+        return None;
+    }
+    pid.parse().ok()
 }
 
 /// The committed state as a VTK frame: displacement and contact fields on the nodes (and,
@@ -381,5 +489,45 @@ pub fn frame(sim: &Simulation) -> Frame {
             Field::scalar("von_mises", von_mises),
             Field::scalar("equivalent_plastic_strain", eq_plastic),
         ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_our_temporaries_of_dead_processes_are_removed() {
+        assert_eq!(
+            stale_temporary_pid(".checkpoint_0004.json.4242.tmp"),
+            Some(4242)
+        );
+        assert_eq!(stale_temporary_pid(".frame_0001.vtu.7.tmp"), Some(7));
+        for other in [
+            "checkpoint_0004.json.4242.tmp",
+            ".checkpoint_0004.json.42a.tmp",
+            ".notes.txt.4242.tmp",
+            ".json.4242.tmp",
+            ".checkpoint_0004.json..tmp",
+            ".checkpoint_0004.json.4242.tmp~",
+        ] {
+            assert_eq!(stale_temporary_pid(other), None, "{other}");
+        }
+        let root = crate::output::test_util::temp_dir("stale");
+        std::fs::create_dir_all(root.join("checkpoints")).unwrap();
+        // A PID above the kernel's pid_max (4194304) is never running.
+        let dead = root.join("checkpoints/.checkpoint_0002.json.99999999.tmp");
+        let alive = root.join(format!(
+            "checkpoints/.checkpoint_0003.json.{}.tmp",
+            std::process::id()
+        ));
+        let foreign = root.join("checkpoints/.mine.txt.99999999.tmp");
+        for f in [&dead, &alive, &foreign] {
+            std::fs::write(f, "x").unwrap();
+        }
+        let removed = remove_stale_temporaries(&root);
+        assert_eq!(removed, vec![(dead.clone(), 99999999)]);
+        assert!(!dead.exists() && alive.exists() && foreign.exists());
+        let _ = std::fs::remove_dir_all(&root);
     }
 }

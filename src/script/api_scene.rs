@@ -20,7 +20,7 @@ pub struct ScriptMaterial(pub Arc<dyn Material>);
 pub struct ScriptSurface(pub Arc<dyn RigidSurface>);
 
 pub fn register(engine: &mut Engine, host: std::rc::Rc<super::HostOptions>) {
-    register_mesh(engine);
+    register_mesh(engine, host.limits.clone());
     register_material(engine);
     register_tools(engine);
     register_friction(engine, host);
@@ -121,25 +121,37 @@ fn parse_grading(spec: &Map) -> ScriptResult<[Grading; 3]> {
     Ok(g)
 }
 
-fn register_mesh(engine: &mut Engine) {
+/// The cell counts of a block, refused before the mesh is built when its estimated memory is
+/// over the run's limit.
+fn block_cells(cells: &Array, limits: &super::limits::Limits) -> ScriptResult<[usize; 3]> {
+    let n = counts3(cells, "block cells")?;
+    let nodes = n
+        .iter()
+        .fold(1u64, |acc, &k| acc.saturating_mul((k as u64).saturating_add(1)));
+    limits.check_mesh(nodes).or_else(runtime_error)?;
+    Ok(n)
+}
+
+fn register_mesh(engine: &mut Engine, limits: super::limits::Limits) {
     engine.register_type_with_name::<Mesh>("Mesh");
+    let l = limits.clone();
     engine.register_fn(
         "block",
-        |origin: Array, size: Array, cells: Array| -> ScriptResult<Mesh> {
+        move |origin: Array, size: Array, cells: Array| -> ScriptResult<Mesh> {
             lift(Mesh::block(
                 vec3(&origin, "block origin")?,
                 vec3(&size, "block size")?,
-                counts3(&cells, "block cells")?,
+                block_cells(&cells, &l)?,
             ))
         },
     );
     engine.register_fn(
         "block",
-        |origin: Array, size: Array, cells: Array, grading: Map| -> ScriptResult<Mesh> {
+        move |origin: Array, size: Array, cells: Array, grading: Map| -> ScriptResult<Mesh> {
             lift(Mesh::block_graded(
                 vec3(&origin, "block origin")?,
                 vec3(&size, "block size")?,
-                counts3(&cells, "block cells")?,
+                block_cells(&cells, &limits)?,
                 parse_grading(&grading)?,
             ))
         },

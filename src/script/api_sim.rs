@@ -30,6 +30,14 @@ pub struct SimState {
     wall_time: Option<f64>,
     /// Per converged increment: (index, time, per tool, per candidate [work, mu, status]).
     node_log: Vec<NodeSnapshot>,
+    /// The script's own values (`sim.keep`), saved in every checkpoint and restored with it.
+    kept: serde_json::Map<String, serde_json::Value>,
+    /// A periodic checkpoint due for the committed state. It is written when the script
+    /// steps again, stops or ends, so that it holds what the script kept after seeing the
+    /// increment (a restarted run then repeats the script's bookkeeping exactly).
+    checkpoint_due: Option<String>,
+    /// Increment count of the state last saved as checkpoints/final.json.
+    final_saved: Option<usize>,
 }
 
 type NodeSnapshot = (usize, f64, Vec<Vec<[f64; 3]>>);
@@ -37,7 +45,17 @@ type NodeSnapshot = (usize, f64, Vec<Vec<[f64; 3]>>);
 /// One increment with script friction laws applied: the simulation is not borrowed while
 /// a script function runs (it may itself query the simulation).
 fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementReport> {
-    let report = s.borrow_mut().step_once()?;
+    let (done, cap, clock) = {
+        let st = s.borrow();
+        let done = st.sim.as_ref().map_or(0, |x| x.history.len());
+        (done, st.host.limits.max_increments, st.host.clock.clone())
+    };
+    if done >= cap {
+        return runtime_error(format!(
+            "the simulation has taken {done} increments, the limit (raise it with --max-increments)"
+        ));
+    }
+    let report = clock.exclude(|| s.borrow_mut().step_once())?;
     let pending: Vec<(usize, FnPtr, Vec<FrictionInput>)> = {
         let st = s.borrow();
         let sim = st.sim.as_ref().expect("started");
@@ -57,14 +75,27 @@ fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementRepo
         let mu = inputs
             .iter()
             .map(|q| law.call_within_context::<f64>(ctx, (q.work, q.slip, q.pressure)))
-            .collect::<ScriptResult<Vec<f64>>>()?;
-        lift(
-            s.borrow_mut()
-                .sim
-                .as_mut()
-                .expect("started")
-                .set_friction_coefficients(c, &mu),
-        )?;
+            .collect::<ScriptResult<Vec<f64>>>();
+        let applied = mu.and_then(|mu| {
+            lift(
+                s.borrow_mut()
+                    .sim
+                    .as_mut()
+                    .expect("started")
+                    .set_friction_coefficients(c, &mu),
+            )
+        });
+        if let Err(e) = applied {
+            // The increment converged: its history row is kept whatever the law did.
+            let mut st = s.borrow_mut();
+            let SimState { sim, output, .. } = &mut *st;
+            if let (Some(out), Some(sim)) = (output.as_mut(), sim.as_ref()) {
+                if let Err(w) = out.record(sim) {
+                    eprintln!("warning: {w}");
+                }
+            }
+            return Err(e);
+        }
     }
     s.borrow_mut().record_step(&report)?;
     Ok(report)
@@ -72,6 +103,66 @@ fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementRepo
 
 /// Shared handle: Rhai values are clones of it.
 pub type ScriptSim = Rc<RefCell<SimState>>;
+
+/// What ends the REPL's loading of a script at its first `sim.step()`.
+pub const DEFERRED: &str = "(repl) stepping deferred";
+
+/// Every simulation a script created, so that the host can record a stop (or write the
+/// due checkpoints at the end) whatever variables the script kept.
+#[derive(Clone, Default)]
+pub struct Simulations(Rc<RefCell<Vec<ScriptSim>>>);
+
+impl std::fmt::Debug for Simulations {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Simulations({})", self.0.borrow().len())
+    }
+}
+
+impl Simulations {
+    fn add(&self, sim: ScriptSim) {
+        self.0.borrow_mut().push(sim);
+    }
+
+    /// Forgets the simulations of an earlier script.
+    pub fn clear(&self) {
+        self.0.borrow_mut().clear();
+    }
+
+    /// Whether any simulation has started (taken its first step or query).
+    pub fn any_started(&self) -> bool {
+        self.0.borrow().iter().any(|s| s.borrow().sim.is_some())
+    }
+
+    /// Records a stop in every started simulation's output folder (see
+    /// [`SimState::record_stop`]).
+    pub fn record_stop(&self, status: &str, reason: &str) {
+        for s in self.0.borrow().iter() {
+            if let Ok(mut st) = s.try_borrow_mut() {
+                st.record_stop(status, reason);
+            }
+        }
+    }
+
+    /// Writes the checkpoints still due (the script ended normally).
+    pub fn close(&self) -> crate::Result<()> {
+        for s in self.0.borrow().iter() {
+            if let Ok(mut st) = s.try_borrow_mut() {
+                st.write_due_checkpoint()
+                    .map_err(|e| Error::Script(e.to_string()))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Times of the started simulations (for the REPL's messages).
+    pub fn times(&self) -> Vec<f64> {
+        self.0
+            .borrow()
+            .iter()
+            .filter_map(|s| s.borrow().sim.as_ref().map(|x| x.time()))
+            .collect()
+    }
+}
 
 impl SimState {
     fn model_mut(&mut self) -> ScriptResult<&mut Model> {
@@ -88,11 +179,14 @@ impl SimState {
                 return runtime_error("the simulation has no model");
             };
             let mut sim = lift(Simulation::new(model))?;
+            sim.set_interrupt(self.host.interrupt.clone());
             self.model = None;
             let frame_times = match self.host.restart.as_ref() {
                 Some(path) if !self.host.restart_used.get() => {
                     self.host.restart_used.set(true);
-                    Some(lift(load_checkpoint(path, &mut sim))?)
+                    let (times, kept) = lift(load_checkpoint(path, &mut sim))?;
+                    self.kept = kept;
+                    Some(times)
                 }
                 _ => None,
             };
@@ -116,37 +210,105 @@ impl SimState {
         Ok(self.sim.as_mut().expect("just set"))
     }
 
-    /// Solves one increment. On failure the summary records why; every frame already
-    /// written stays.
+    /// Solves one increment. On failure the summary records why and the last converged
+    /// state is saved; every frame already written stays. An interrupt ends the script
+    /// (not catchable by `try`): the host records the stop.
     fn step_once(&mut self) -> ScriptResult<IncrementReport> {
         self.simulation()?;
+        self.write_due_checkpoint()?;
         let sim = self.sim.as_mut().expect("started");
         match sim.step() {
             Ok(report) => Ok(report),
+            Err(Error::Interrupted(why)) => Err(interrupted(&why)),
             Err(err) => {
                 let mut err = err;
-                if let Some(out) = self.output.as_mut() {
-                    let wall = self
-                        .started
-                        .map(|s| s.elapsed().as_secs_f64())
-                        .unwrap_or(0.0);
-                    // The last converged state, to restart from with other settings.
-                    match out.write_checkpoint(sim, "checkpoints/final.json") {
-                        Ok(path) => {
-                            err = Error::NoConvergence(format!(
-                                "{}; last converged state (t = {}) saved in {}",
-                                err.to_string().trim_start_matches("no convergence: "),
-                                sim.time(),
-                                path.display()
-                            ))
-                        }
-                        Err(e) => eprintln!("warning: cannot write the final checkpoint: {e}"),
-                    }
-                    let _ = out.write_summary(sim, wall, Some(&err.to_string()));
+                if let Some(saved) = self.record_stop("stopped", &err.to_string()) {
+                    err = Error::NoConvergence(format!(
+                        "{}; {saved}",
+                        err.to_string().trim_start_matches("no convergence: "),
+                    ));
                 }
                 fail(err)
             }
         }
+    }
+
+    /// Writes the periodic checkpoint due for the committed state, if any.
+    fn write_due_checkpoint(&mut self) -> ScriptResult<()> {
+        let (Some(out), Some(sim), Some(name)) = (
+            self.output.as_ref(),
+            self.sim.as_ref(),
+            self.checkpoint_due.take(),
+        ) else {
+            return Ok(());
+        };
+        lift(out.write_checkpoint(sim, &name, &self.kept)).map(|_| ())
+    }
+
+    /// Records a stop of the run (no convergence, a script error, a signal, a failed
+    /// write): the due checkpoint, checkpoints/final.json with the last converged state
+    /// (when every unknown is finite), the history rows not written yet, and summary.json
+    /// with `status` ("stopped" or "interrupted") and `reason`. A write that fails is
+    /// reported on stderr naming its file and listed in the summary; the others are still
+    /// made. Returns where the last converged state was saved, if it was. Nothing is
+    /// written when the simulation has not started or its output is off.
+    pub(super) fn record_stop(&mut self, status: &str, reason: &str) -> Option<String> {
+        let wall = self.elapsed();
+        let (Some(out), Some(sim)) = (self.output.as_mut(), self.sim.as_ref()) else {
+            return None;
+        };
+        let mut failures = Vec::new();
+        let note = |e: Error, failures: &mut Vec<String>| {
+            eprintln!("warning: {e}");
+            failures.push(e.to_string());
+        };
+        if let Some(name) = self.checkpoint_due.take() {
+            if let Err(e) = out.write_checkpoint(sim, &name, &self.kept) {
+                note(e, &mut failures);
+            }
+        }
+        let mut saved = None;
+        if sim.unknowns().iter().all(|v| v.is_finite()) {
+            if self.final_saved == Some(sim.history.len()) {
+                saved = out
+                    .folder()
+                    .resolve("checkpoints/final.json")
+                    .ok()
+                    .map(|p| p.display().to_string());
+            } else {
+                match out.write_checkpoint(sim, "checkpoints/final.json", &self.kept) {
+                    Ok(path) => {
+                        saved = Some(path.display().to_string());
+                        self.final_saved = Some(sim.history.len());
+                    }
+                    Err(e) => note(e, &mut failures),
+                }
+            }
+        } else {
+            failures.push("checkpoints/final.json not written: the state is not finite".into());
+        }
+        if let Err(e) = out.record(sim) {
+            note(e, &mut failures);
+        }
+        let stop = crate::output::run::Stop {
+            status: status.to_string(),
+            reason: reason.to_string(),
+            final_checkpoint: saved.clone(),
+            write_failures: failures,
+        };
+        if let Err(e) = out.write_stop_summary(sim, wall, &stop) {
+            eprintln!("warning: {e}");
+        }
+        saved.map(|path| format!("last converged state (t = {}) saved in {path}", sim.time()))
+    }
+
+    /// What the script keeps (`sim.keep`), as checkpoints store it.
+    pub(super) fn keep(&mut self, name: &str, value: serde_json::Value) {
+        self.kept.insert(name.to_string(), value);
+    }
+
+    pub(super) fn kept(&mut self, name: &str) -> Option<&serde_json::Value> {
+        self.kept.get(name)
     }
 
     fn elapsed(&self) -> f64 {
@@ -196,10 +358,8 @@ impl SimState {
             }
             let ck = self.checkpoint_every;
             if ck > 0 && (report.index % ck == 0 || sim.is_finished()) {
-                lift(out.write_checkpoint(
-                    sim,
-                    &format!("checkpoints/checkpoint_{:04}.json", report.index),
-                ))?;
+                self.checkpoint_due =
+                    Some(format!("checkpoints/checkpoint_{:04}.json", report.index));
             }
         }
         let snapshot = (0..sim.model.contacts.len())
@@ -292,19 +452,34 @@ fn tool_names(s: &SimState) -> Vec<String> {
     model.contacts.iter().map(|c| c.tool.name.clone()).collect()
 }
 
-/// Reads a checkpoint file into `sim`; returns the times of the frames written before it.
-fn load_checkpoint(path: &std::path::Path, sim: &mut Simulation) -> crate::Result<Vec<f64>> {
+/// Reads a checkpoint file into `sim`; returns the times of the frames written before it
+/// and the values the script kept.
+fn load_checkpoint(
+    path: &std::path::Path,
+    sim: &mut Simulation,
+) -> crate::Result<(Vec<f64>, serde_json::Map<String, serde_json::Value>)> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     let ck = Checkpoint::from_json(&text, &path.display().to_string())?;
     let times = ck.frame_times.clone();
+    let kept = ck.script.clone();
     ck.restore(sim)?;
-    Ok(times)
+    Ok((times, kept))
+}
+
+/// The error that ends a script on an interrupt: not catchable by the script's `try`.
+pub(super) fn interrupted(why: &str) -> Box<rhai::EvalAltResult> {
+    Box::new(rhai::EvalAltResult::ErrorTerminated(
+        Dynamic::from(format!("interrupted: {why}")),
+        rhai::Position::NONE,
+    ))
 }
 
 /// Output knobs of the script layer.
 struct Knobs {
     output_every: usize,
     checkpoint_every: usize,
+    /// `--max-increments`: a larger `increments` setting is refused.
+    max_increments: usize,
 }
 
 fn choice<'a>(v: &Dynamic, key: &str, options: &[&'a str]) -> ScriptResult<&'a str> {
@@ -366,10 +541,24 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             "cycle_flips" => step.cycle_flips = count(key)?,
             "rollback_depth" => step.rollback_depth = count(key)?,
             "checkpoint_every" => st.checkpoint_every = count(key)?,
-            "increments" => s.increments = num("increments")? as usize,
+            "increments" => {
+                let n = number(v, key)?;
+                let cap = st.max_increments as f64;
+                if !(n >= 1.0 && n <= cap && n.fract() == 0.0) {
+                    return fail(Error::input(
+                        key,
+                        n,
+                        &format!(
+                            "must be a whole number from 1 to {} (raise the cap with --max-increments)",
+                            st.max_increments
+                        ),
+                    ));
+                }
+                s.increments = n as usize;
+            }
             "end_time" => s.end_time = num("end_time")?,
-            "max_iterations" => s.max_iterations = num("max_iterations")? as usize,
-            "max_cutbacks" => s.max_cutbacks = num("max_cutbacks")? as usize,
+            "max_iterations" => s.max_iterations = count(key)?,
+            "max_cutbacks" => s.max_cutbacks = count(key)?,
             "force_tolerance" => s.force_rel_tol = num("force_tolerance")?,
             "force_abs_tolerance" => s.force_abs_tol = num("force_abs_tolerance")?,
             "contact_tolerance" => s.contact_tol = num("contact_tolerance")?,
@@ -385,6 +574,11 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
                 s.eliminate_multipliers = v
                     .as_bool()
                     .map_err(|t| format!("eliminate_multipliers must be true or false, got {t}"))
+                    .or_else(runtime_error)?
+            }
+            "linear_solver" => {
+                let name = v.clone().into_string().unwrap_or_default();
+                s.linear_solver = crate::solver::linear::LinearSolverKind::from_name(&name)
                     .or_else(runtime_error)?
             }
             "kinematics" => {
@@ -427,7 +621,7 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, extrapolate, threads, kinematics, fbar, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
+                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, linear_solver, extrapolate, threads, kinematics, fbar, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
                 ))
             }
         }
@@ -462,9 +656,10 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             let mut knobs = Knobs {
                 output_every: 1,
                 checkpoint_every: 0,
+                max_increments: h.limits.max_increments,
             };
             apply_settings(&mut model.settings, &mut knobs, &h.base_settings)?;
-            Ok(Rc::new(RefCell::new(SimState {
+            let sim = Rc::new(RefCell::new(SimState {
                 model: Some(model),
                 sim: None,
                 output: None,
@@ -474,7 +669,12 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 started: None,
                 wall_time: None,
                 node_log: Vec::new(),
-            })))
+                kept: serde_json::Map::new(),
+                checkpoint_due: None,
+                final_saved: None,
+            }));
+            h.simulations.add(sim.clone());
+            Ok(sim)
         },
     );
     engine.register_fn(
@@ -534,6 +734,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             let mut knobs = Knobs {
                 output_every: st.output_every,
                 checkpoint_every: st.checkpoint_every,
+                max_increments: st.host.limits.max_increments,
             };
             if let Some(model) = st.model.as_mut() {
                 apply_settings(&mut model.settings, &mut knobs, &spec)?;
@@ -549,9 +750,18 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             Ok(())
         },
     );
+    let h = host.clone();
     engine.register_fn(
         "step",
-        |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> {
+        move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> {
+            if h.defer_run.get() {
+                // The REPL loading a script that steps itself: loading ends here, with the
+                // scene built and nothing stepped.
+                return Err(Box::new(rhai::EvalAltResult::ErrorTerminated(
+                    Dynamic::from(DEFERRED),
+                    rhai::Position::NONE,
+                )));
+            }
             let r = advance(&ctx, s)?;
             let mut st = s.borrow_mut();
             if st.sim.as_ref().is_some_and(|x| x.is_finished()) {
@@ -613,6 +823,30 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             st.finish()?;
             let names = tool_names(&st);
             Ok(last.map(|r| report_map(&r, &names)).unwrap_or_default())
+        },
+    );
+    // The script's own values across a restart: kept in every checkpoint, restored with it.
+    engine.register_fn(
+        "keep",
+        |s: &mut ScriptSim, name: &str, value: Dynamic| -> ScriptResult<()> {
+            if name.is_empty() {
+                return runtime_error("sim.keep needs a non-empty name");
+            }
+            let json = super::convert::keepable_json(&value, name)?;
+            s.borrow_mut().keep(name, json);
+            Ok(())
+        },
+    );
+    engine.register_fn(
+        "kept",
+        |s: &mut ScriptSim, name: &str| -> ScriptResult<Dynamic> {
+            let mut st = s.borrow_mut();
+            // Starting the simulation loads the restart checkpoint, if any.
+            st.simulation()?;
+            Ok(st
+                .kept(name)
+                .map(super::convert::from_json)
+                .unwrap_or(Dynamic::UNIT))
         },
     );
     engine.register_get("time", |s: &mut ScriptSim| {
@@ -787,11 +1021,13 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         |s: &mut ScriptSim, path: &str| -> ScriptResult<String> {
             let mut st = s.borrow_mut();
             st.simulation()?;
-            let SimState { sim, output, .. } = &mut *st;
+            let SimState {
+                sim, output, kept, ..
+            } = &mut *st;
             match (output.as_ref(), sim.as_ref()) {
-                (Some(out), Some(sim)) => {
-                    Ok(lift(out.write_checkpoint(sim, path))?.display().to_string())
-                }
+                (Some(out), Some(sim)) => Ok(lift(out.write_checkpoint(sim, path, kept))?
+                    .display()
+                    .to_string()),
                 _ => runtime_error("output is off for this simulation (settings output_every = 0)"),
             }
         },
@@ -812,7 +1048,9 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         move |path: &str, text: &str| -> ScriptResult<String> {
             let folder = lift(crate::output::OutputFolder::create(&h.out_dir))?;
             let file = lift(folder.resolve_for_write(path))?;
-            lift(std::fs::write(&file, text).map_err(|e| Error::io(&file, e)))?;
+            lift(crate::paths::create_file(&file)
+                .and_then(|mut f| std::io::Write::write_all(&mut f, text.as_bytes()))
+                .map_err(|e| Error::io(&file, e)))?;
             Ok(file.display().to_string())
         },
     );

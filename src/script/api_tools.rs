@@ -7,15 +7,15 @@ use super::convert::*;
 use crate::geometry::builders::{
     blankholder_patches, die_patches, punch_patches, BlankholderSpec, DieSpec, Extent, PunchSpec,
 };
-use crate::geometry::patch_table::{load_patches_json, patch_from_rows};
+use crate::geometry::patch_table::{patch_from_rows, patches_from_json};
 use crate::geometry::{BezierPatch, PatchSurface, Vec3};
 use rhai::{Array, Dynamic, Engine, Map};
-use std::path::{Path, PathBuf};
+
 use std::sync::Arc;
 
-pub fn register(engine: &mut Engine, script_dir: Option<&Path>) {
+pub fn register(engine: &mut Engine, policy: std::rc::Rc<crate::paths::ReadPolicy>) {
     register_patches(engine);
-    register_surfaces(engine, script_dir.map(Path::to_path_buf));
+    register_surfaces(engine, policy);
     register_builders(engine);
 }
 
@@ -168,7 +168,7 @@ fn surface(s: PatchSurface) -> ScriptSurface {
     ScriptSurface(Arc::new(s))
 }
 
-fn register_surfaces(engine: &mut Engine, script_dir: Option<PathBuf>) {
+fn register_surfaces(engine: &mut Engine, policy: std::rc::Rc<crate::paths::ReadPolicy>) {
     engine.register_fn(
         "patch_surface",
         |list: Array| -> ScriptResult<ScriptSurface> {
@@ -185,15 +185,12 @@ fn register_surfaces(engine: &mut Engine, script_dir: Option<PathBuf>) {
             ))?))
         },
     );
-    // bezier_surface_json(path): relative to the script's folder.
+    // bezier_surface_json(path): relative to the script's folder, read through the policy.
     engine.register_fn(
         "bezier_surface_json",
         move |path: &str| -> ScriptResult<ScriptSurface> {
-            let full = match &script_dir {
-                Some(dir) if Path::new(path).is_relative() => dir.join(path),
-                _ => PathBuf::from(path),
-            };
-            let (patches, outside) = lift(load_patches_json(&full))?;
+            let (_, text) = lift(policy.read_to_string(path, "JSON table"))?;
+            let (patches, outside) = lift(patches_from_json(path, &text))?;
             Ok(surface(lift(match outside {
                 Some(p) => PatchSurface::with_outside_point(patches, p),
                 None => PatchSurface::new(patches),

@@ -66,3 +66,64 @@ pub fn counts3(a: &Array, what: &str) -> ScriptResult<[usize; 3]> {
     }
     Ok(out)
 }
+
+/// A value `sim.keep` can store in a checkpoint, as JSON that [`from_json`] turns back into
+/// the same value: unit, booleans, integers, finite floats, strings, arrays and maps of
+/// them. `at` names the place in the value for errors (a NaN would come back as unit).
+pub fn keepable_json(v: &Dynamic, at: &str) -> ScriptResult<serde_json::Value> {
+    use serde_json::Value;
+    if v.is_unit() {
+        Ok(Value::Null)
+    } else if let Ok(b) = v.as_bool() {
+        Ok(Value::Bool(b))
+    } else if let Ok(i) = v.as_int() {
+        Ok(Value::from(i))
+    } else if let Ok(f) = v.as_float() {
+        match serde_json::Number::from_f64(f) {
+            Some(n) => Ok(Value::Number(n)),
+            None => runtime_error(format!(
+                "sim.keep: {at} = {f} cannot be kept in a checkpoint (only finite numbers)"
+            )),
+        }
+    } else if v.is_string() || v.is_char() {
+        Ok(Value::String(v.to_string()))
+    } else if let Some(a) = v.clone().try_cast::<Array>() {
+        a.iter()
+            .enumerate()
+            .map(|(i, x)| keepable_json(x, &format!("{at}[{i}]")))
+            .collect::<ScriptResult<Vec<_>>>()
+            .map(Value::Array)
+    } else if let Some(m) = v.clone().try_cast::<rhai::Map>() {
+        let mut out = serde_json::Map::new();
+        for (k, x) in &m {
+            out.insert(k.to_string(), keepable_json(x, &format!("{at}.{k}"))?);
+        }
+        Ok(Value::Object(out))
+    } else {
+        runtime_error(format!(
+            "sim.keep: {at} is a {} which a checkpoint cannot hold (use numbers, strings, booleans, arrays, maps)",
+            v.type_name()
+        ))
+    }
+}
+
+/// The Rhai value of JSON written by [`keepable_json`]: a number written with a fraction
+/// or exponent is a float, one without an integer (serde_json writes every f64 with one).
+pub fn from_json(v: &serde_json::Value) -> Dynamic {
+    use serde_json::Value;
+    match v {
+        Value::Null => Dynamic::UNIT,
+        Value::Bool(b) => Dynamic::from(*b),
+        Value::Number(n) => match n.as_i64() {
+            Some(i) => Dynamic::from(i),
+            None => Dynamic::from(n.as_f64().unwrap_or(f64::NAN)),
+        },
+        Value::String(s) => Dynamic::from(s.clone()),
+        Value::Array(a) => Dynamic::from(a.iter().map(from_json).collect::<Array>()),
+        Value::Object(m) => Dynamic::from(
+            m.iter()
+                .map(|(k, x)| (k.as_str().into(), from_json(x)))
+                .collect::<rhai::Map>(),
+        ),
+    }
+}

@@ -9,11 +9,13 @@ mod api_scene;
 mod api_sim;
 mod api_tools;
 mod convert;
+pub mod limits;
 pub mod repl;
 mod stdlib;
 
-pub use api_sim::ScriptSim;
+pub use api_sim::{ScriptSim, Simulations, DEFERRED};
 
+use crate::paths::ReadPolicy;
 use crate::{Error, Result};
 use rhai::{Dynamic, Engine, EvalAltResult, Position, Scope, AST};
 use std::path::{Path, PathBuf};
@@ -46,6 +48,18 @@ pub struct HostOptions {
     pub base_settings: rhai::Map,
     /// Show the script's `print` output (a study running many scripts turns it off).
     pub script_print: bool,
+    /// Stop request (SIGINT/SIGTERM): polled between increments and Newton iterations.
+    pub interrupt: crate::interrupt::Interrupt,
+    /// The simulations the script created (the host records stops in their folders).
+    pub simulations: Simulations,
+    /// Folders scripts may read besides their own (`--allow-read DIR`).
+    pub allow_read: Vec<PathBuf>,
+    /// Largest file a script may read (imports, JSON tables), in bytes.
+    pub max_read_bytes: u64,
+    /// Memory, script time, increments and output size ([`limits`]).
+    pub limits: limits::Limits,
+    /// The script's own time (the engine sets a fresh one).
+    pub clock: Rc<limits::ScriptClock>,
 }
 
 impl Default for HostOptions {
@@ -61,6 +75,12 @@ impl Default for HostOptions {
             warnings: true,
             base_settings: rhai::Map::new(),
             script_print: true,
+            interrupt: crate::interrupt::Interrupt::new(),
+            simulations: Simulations::default(),
+            allow_read: Vec::new(),
+            max_read_bytes: crate::paths::DEFAULT_MAX_READ_BYTES,
+            limits: limits::Limits::default(),
+            clock: Rc::default(),
         }
     }
 }
@@ -74,17 +94,34 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.set_max_string_size(1 << 20);
     engine.set_max_array_size(1 << 22);
     engine.set_max_map_size(1 << 16);
-    engine.set_module_resolver(stdlib::resolver(script_dir));
+    let policy = Rc::new(read_policy(host, script_dir).unwrap_or_else(|_| ReadPolicy::nothing()));
+    engine.set_module_resolver(stdlib::resolver(policy.clone()));
     if !host.script_print {
         engine.on_print(|_| {});
     }
-    let host = Rc::new(host.clone());
+    let mut host = host.clone();
+    host.clock = Rc::default();
+    let (limits, clock) = (host.limits.clone(), host.clock.clone());
+    engine.on_progress(move |ops| {
+        limits::progress_check(&limits, &clock, ops).map(Dynamic::from)
+    });
+    let host = Rc::new(host);
     api_scene::register(&mut engine, host.clone());
-    api_tools::register(&mut engine, script_dir);
+    api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);
     register_checks(&mut engine);
     engine
+}
+
+/// Where the script at `script_dir` may read: its folder and the `--allow-read` folders
+/// (an error names a folder that cannot be opened).
+pub fn read_policy(host: &HostOptions, script_dir: Option<&Path>) -> Result<ReadPolicy> {
+    ReadPolicy::new(
+        script_dir.unwrap_or(Path::new(".")),
+        &host.allow_read,
+        host.max_read_bytes,
+    )
 }
 
 /// Assertions for scripted test cases: a failed one stops the script with its message.
@@ -125,11 +162,26 @@ fn register_checks(engine: &mut Engine) {
 /// another source (a std-lib module) is reported where this file called it.
 pub fn describe_error(file: &str, err: &EvalAltResult) -> String {
     let pos = innermost_position(file, err);
-    let msg = err.to_string();
+    let msg = message(err);
     match (pos.line(), pos.position()) {
         (Some(l), Some(c)) => format!("{file}:{l}:{c}: {msg}"),
         (Some(l), None) => format!("{file}:{l}: {msg}"),
         _ => format!("{file}: {msg}"),
+    }
+}
+
+/// The message of an error, with a limit's own text for a script the progress check stopped.
+fn message(err: &EvalAltResult) -> String {
+    match err {
+        EvalAltResult::ErrorTerminated(why, _) => format!("stopped: {why}"),
+        EvalAltResult::ErrorInFunctionCall(_, _, inner, _) => {
+            if let EvalAltResult::ErrorTerminated(..) = &**inner {
+                message(inner)
+            } else {
+                err.to_string()
+            }
+        }
+        other => other.to_string(),
     }
 }
 
@@ -191,14 +243,47 @@ pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
 }
 
 /// Runs a script file to its end.
+///
+/// Every stop is recorded in the output folder of each simulation the script started:
+/// summary.json with the status ("stopped", or "interrupted" after a signal) and the
+/// reason, and checkpoints/final.json with the last converged state (see
+/// `SimState::record_stop`). An interrupt returns `Error::Interrupted`. A `--restart`
+/// checkpoint that no simulation used is an error.
 pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions) -> Result<()> {
+    host.simulations.clear();
     let engine = engine(host, path.parent());
     let ast = compile(&engine, path)?;
+    // The --allow-read folders exist (the engine would otherwise refuse every read quietly).
+    read_policy(host, path.parent())?;
+    // Held to the end of the run: a second run into the same folder is refused.
+    let _lock = crate::output::FolderLock::acquire(&host.out_dir)?;
     let ast = apply_overrides(&engine, ast, overrides, path)?;
     let mut scope = Scope::new();
-    engine
+    let outcome = engine
         .run_ast_with_scope(&mut scope, &ast)
         .map_err(|e| Error::Script(describe_error(&path.display().to_string(), &e)))
+        .and_then(|()| host.simulations.close());
+    let outcome = outcome.and_then(|()| match &host.restart {
+        Some(file) if !host.restart_used.get() => Err(Error::Input(format!(
+            "--restart {}: the script {} started no simulation, so the checkpoint was not used",
+            file.display(),
+            path.display()
+        ))),
+        _ => Ok(()),
+    });
+    match outcome {
+        Ok(()) => Ok(()),
+        Err(err) if host.interrupt.is_raised() => {
+            let why = host.interrupt.reason();
+            host.simulations.record_stop("interrupted", &why);
+            let _ = err;
+            Err(Error::Interrupted(why))
+        }
+        Err(err) => {
+            host.simulations.record_stop("stopped", &err.to_string());
+            Err(err)
+        }
+    }
 }
 
 /// `--set NAME=VALUE` replaces the value of the script's top-level `let NAME = ...;`

@@ -1,11 +1,18 @@
 //! Interactive stepping: `tribo repl [SCRIPT]`.
 //!
 //! Lines are evaluated in one persistent scope. A script given on the command line is run
-//! first with `sim.run()` deferred, so its scene can be stepped by hand.
+//! first with stepping deferred, so its scene can be stepped by hand: `sim.run()` returns
+//! at once and the script goes on, a `sim.step()` ends the loading there (a script that
+//! steps itself in a loop is loaded up to that loop).
+//!
+//! Ctrl-C while a line runs (`sim.run()`, `sim.step()`) abandons the increment under way
+//! and returns to the prompt; the simulation keeps the state of its last converged
+//! increment and the next `sim.step()` goes on from there. At the prompt, Ctrl-C clears
+//! the line (rustyline's behaviour) and Ctrl-D leaves.
 
-use super::{compile, describe_error, engine, HostOptions};
+use super::{compile, describe_error, engine, HostOptions, DEFERRED};
 use crate::Result;
-use rhai::{Dynamic, Scope};
+use rhai::{Dynamic, EvalAltResult, Scope};
 use rustyline::error::ReadlineError;
 use std::path::Path;
 
@@ -41,6 +48,12 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
                 path.display(),
                 scope.len()
             ),
+            Err(e) if is_deferred(&e) => println!(
+                "loaded {} up to its first sim.step() (line {}; {} variables in scope): step with sim.step() or sim.run()",
+                path.display(),
+                e.position().line().unwrap_or(0),
+                scope.len()
+            ),
             Err(e) => println!(
                 "error while loading: {}",
                 describe_error(&path.display().to_string(), &e)
@@ -70,10 +83,10 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
                     }
                     _ => {}
                 }
-                match engine.eval_with_scope::<Dynamic>(&mut scope, line) {
-                    Ok(v) if v.is_unit() => {}
-                    Ok(v) => println!("{v}"),
-                    Err(e) => println!("error: {}", describe_error("<repl>", &e)),
+                let result = engine.eval_with_scope::<Dynamic>(&mut scope, line);
+                let text = outcome_line(&result, host);
+                if !text.is_empty() {
+                    println!("{text}");
                 }
             }
             Err(ReadlineError::Interrupted) => continue,
@@ -82,4 +95,42 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// What the REPL prints after evaluating a line. After Ctrl-C (the host's interrupt flag)
+/// the flag is withdrawn, so that the next line steps again, and the message gives the
+/// time of the state kept.
+pub fn outcome_line(
+    result: &std::result::Result<Dynamic, Box<EvalAltResult>>,
+    host: &HostOptions,
+) -> String {
+    match result {
+        Ok(v) if v.is_unit() => String::new(),
+        Ok(v) => v.to_string(),
+        Err(_) if host.interrupt.is_raised() => {
+            host.interrupt.clear();
+            let times: Vec<String> = host
+                .simulations
+                .times()
+                .iter()
+                .map(|t| t.to_string())
+                .collect();
+            format!(
+                "interrupted: back at the last converged increment (t = {}); sim.step() goes on from there",
+                times.join(", ")
+            )
+        }
+        Err(e) => format!("error: {}", describe_error("<repl>", e)),
+    }
+}
+
+/// Whether loading stopped at the script's first `sim.step()` (see `DEFERRED`).
+fn is_deferred(e: &EvalAltResult) -> bool {
+    match e {
+        EvalAltResult::ErrorTerminated(v, _) => {
+            v.clone().into_string().is_ok_and(|s| s == DEFERRED)
+        }
+        EvalAltResult::ErrorInFunctionCall(_, _, inner, _) => is_deferred(inner),
+        _ => false,
+    }
 }

@@ -14,17 +14,18 @@
 
 use super::force_control;
 use super::model::Model;
+use super::slots::AssemblySlots;
 use super::sparse::{SparseMatrix, SparsePattern};
 use crate::contact::{
     alart_curnier, BernsteinLaw, ContactNodeState, Enforcement, FrictionUpdate, NodalContact,
     OperatorParams,
 };
-use crate::element::{hexahedron, in_element, ElementResponse};
+use crate::element::{hexahedron, in_element};
 use crate::geometry::{Mat3, Projection, Vec3};
 use crate::material::PointState;
 use crate::tool::pose::Pose;
 use crate::{Error, Result};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// Where each unknown lives.
@@ -37,6 +38,9 @@ pub struct DofMap {
     /// `force_control`.
     pub tool_offset: Vec<Option<usize>>,
     pub n_dofs: usize,
+    /// Value positions of the element and contact entries in [`Self::pattern`], built on
+    /// first use.
+    slots: OnceLock<Arc<AssemblySlots>>,
 }
 
 impl DofMap {
@@ -61,6 +65,25 @@ impl DofMap {
             lambda_offset,
             tool_offset,
             n_dofs: next,
+            slots: OnceLock::new(),
+        }
+    }
+
+    /// The assembly slots of `pattern` (built from this map by [`Self::pattern`]): computed
+    /// once and kept; a different pattern gets its own, uncached.
+    fn slots(&self, model: &Model, pattern: &Arc<SparsePattern>) -> Arc<AssemblySlots> {
+        let build = || {
+            Arc::new(AssemblySlots::new(
+                model,
+                &self.lambda_offset,
+                pattern.clone(),
+            ))
+        };
+        let cached = self.slots.get_or_init(build);
+        if cached.indexes(pattern) {
+            cached.clone()
+        } else {
+            build()
         }
     }
 
@@ -108,18 +131,28 @@ fn element_threads(setting: usize) -> usize {
     }
 }
 
+/// Element forces and stiffnesses of one evaluation, element after element: `force[24 e..]`
+/// and `stiffness[576 e..]` (column-major), the latter empty for a residual-only
+/// evaluation.
+struct ElementBuffers {
+    force: Vec<f64>,
+    stiffness: Vec<f64>,
+}
+
 /// Evaluates every element at the unknowns `x`, on `threads` threads over contiguous
-/// blocks of elements, writing the trial states of their integration points. Each
-/// element's response is kept and returned in element order, so that the assembly (and
-/// hence every result) is the same whatever the thread count. The first failing element
-/// in element order is the one reported.
+/// blocks of elements, writing the trial states of their integration points and each
+/// element's force (and, with `tangent`, stiffness) straight into its place in the
+/// returned buffers, so that the assembly (and hence every result) is the same whatever
+/// the thread count. The first failing element in element order is the one reported.
 fn evaluate_elements(
     model: &Model,
     x: &[f64],
     committed: &[PointState],
     trial: &mut [PointState],
     threads: usize,
-) -> Result<Vec<ElementResponse<{ crate::element::hex8::DOFS }>>> {
+    tangent: bool,
+) -> Result<ElementBuffers> {
+    const D: usize = crate::element::hex8::DOFS;
     let element = hexahedron(model.settings.kinematics, model.settings.fbar);
     let per_elem = element.point_count();
     let (hexes, nodes, material) = (
@@ -127,37 +160,62 @@ fn evaluate_elements(
         &model.mesh.nodes,
         model.material.as_ref(),
     );
-    let evaluate_block = |first: usize, trial: &mut [PointState]| {
-        let mut out = Vec::with_capacity(trial.len() / per_elem.max(1));
-        let mut xs = [Vec3::zeros(); 8];
-        let mut us = [Vec3::zeros(); 8];
-        for (k, trial_e) in trial.chunks_mut(per_elem).enumerate() {
-            let e = first + k;
-            for (a, &node) in hexes[e].iter().enumerate() {
-                xs[a] = nodes[node];
-                us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
-            }
-            let committed_e = &committed[e * per_elem..(e + 1) * per_elem];
-            let response = element
-                .evaluate(&xs, &us, committed_e, trial_e, material)
-                .map_err(|err| Error::NoConvergence(in_element(err, e).to_string()))?;
-            out.push(response);
-        }
-        Ok::<_, Error>(out)
+    let n_elem = hexes.len();
+    let mut buffers = ElementBuffers {
+        force: vec![0.0; n_elem * D],
+        stiffness: vec![0.0; if tangent { n_elem * D * D } else { 0 }],
     };
+    let evaluate_block =
+        |first: usize, trial: &mut [PointState], force: &mut [f64], stiffness: &mut [f64]| {
+            let mut xs = [Vec3::zeros(); 8];
+            let mut us = [Vec3::zeros(); 8];
+            let mut stiffness = tangent.then(|| stiffness.chunks_mut(D * D));
+            for (k, (trial_e, force_e)) in trial
+                .chunks_mut(per_elem)
+                .zip(force.chunks_mut(D))
+                .enumerate()
+            {
+                let e = first + k;
+                for (a, &node) in hexes[e].iter().enumerate() {
+                    xs[a] = nodes[node];
+                    us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
+                }
+                let committed_e = &committed[e * per_elem..(e + 1) * per_elem];
+                let stiffness_e = stiffness.as_mut().and_then(|s| s.next());
+                element
+                    .evaluate_into(
+                        &xs,
+                        &us,
+                        committed_e,
+                        trial_e,
+                        material,
+                        force_e,
+                        stiffness_e,
+                    )
+                    .map_err(|err| Error::NoConvergence(in_element(err, e).to_string()))?;
+            }
+            Ok::<_, Error>(())
+        };
     // Below a few dozen elements, starting threads costs more than it saves.
     const MIN_PARALLEL_ELEMENTS: usize = 64;
-    if threads <= 1 || hexes.len() < MIN_PARALLEL_ELEMENTS {
-        return evaluate_block(0, trial);
+    if threads <= 1 || n_elem < MIN_PARALLEL_ELEMENTS {
+        evaluate_block(0, trial, &mut buffers.force, &mut buffers.stiffness)?;
+        return Ok(buffers);
     }
-    let block = hexes.len().div_ceil(threads);
-    let blocks: Vec<Result<Vec<_>>> = std::thread::scope(|scope| {
+    let block = n_elem.div_ceil(threads);
+    let stiffness_block = if tangent { block * D * D } else { 1 };
+    let mut stiffness_chunks: Vec<&mut [f64]> =
+        buffers.stiffness.chunks_mut(stiffness_block).collect();
+    stiffness_chunks.resize_with(n_elem.div_ceil(block), Default::default);
+    let results: Vec<Result<()>> = std::thread::scope(|scope| {
         let handles: Vec<_> = trial
             .chunks_mut(block * per_elem)
+            .zip(buffers.force.chunks_mut(block * D))
+            .zip(stiffness_chunks)
             .enumerate()
-            .map(|(i, chunk)| {
+            .map(|(i, ((trial, force), stiffness))| {
                 let evaluate_block = &evaluate_block;
-                scope.spawn(move || evaluate_block(i * block, chunk))
+                scope.spawn(move || evaluate_block(i * block, trial, force, stiffness))
             })
             .collect();
         handles
@@ -165,11 +223,10 @@ fn evaluate_elements(
             .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
     });
-    let mut all = Vec::with_capacity(hexes.len());
-    for b in blocks {
-        all.extend(b?);
+    for r in results {
+        r?;
     }
-    Ok(all)
+    Ok(buffers)
 }
 
 /// Wall time spent in each phase of assembly (seconds), accumulated.
@@ -203,6 +260,14 @@ pub struct Evaluation {
     pub support_forces: Vec<f64>,
 }
 
+impl Evaluation {
+    /// False for a residual-only evaluation ([`IncrementContext::evaluate_residual`]),
+    /// whose `jacobian` holds no values.
+    pub fn has_jacobian(&self) -> bool {
+        self.jacobian.values.len() == self.jacobian.pattern.nnz()
+    }
+}
+
 /// Inputs that stay fixed during the Newton iterations of one increment.
 pub struct IncrementContext<'a> {
     pub model: &'a Model,
@@ -222,32 +287,61 @@ impl IncrementContext<'_> {
     /// Evaluates residual and Jacobian at displacements `u` and multipliers `lambda`
     /// (the multiplier part of the unknown vector `x = [u, lambda]`).
     pub fn evaluate(&self, x: &[f64], times: &mut PhaseTimes) -> Result<Evaluation> {
+        self.evaluate_with(x, times, true)
+    }
+
+    /// Everything of [`Self::evaluate`] but the Jacobian, for line-search trials: the
+    /// material update, the internal forces and the contact residual, bit for bit those of
+    /// a full evaluation, with neither element tangents nor assembly. The returned
+    /// `jacobian` has no values ([`Evaluation::has_jacobian`] is false): an accepted trial
+    /// is evaluated again in full before Newton solves with it.
+    pub fn evaluate_residual(&self, x: &[f64], times: &mut PhaseTimes) -> Result<Evaluation> {
+        self.evaluate_with(x, times, false)
+    }
+
+    fn evaluate_with(
+        &self,
+        x: &[f64],
+        times: &mut PhaseTimes,
+        with_jacobian: bool,
+    ) -> Result<Evaluation> {
         let model = self.model;
         let n = self.dofs.n_dofs;
         let mut residual = vec![0.0; n];
         let mut f_int = vec![0.0; 3 * self.dofs.n_nodes];
-        let mut jac = SparseMatrix::zeros(self.pattern.clone());
+        // Force-controlled tools add their rows through `SparseMatrix::add` (outside this
+        // module), so a residual-only evaluation still gives them a matrix to write into.
+        let force_controlled = self.dofs.tool_offset.iter().any(Option::is_some);
+        let mut jac = if with_jacobian || force_controlled {
+            SparseMatrix::zeros(self.pattern.clone())
+        } else {
+            SparseMatrix {
+                pattern: self.pattern.clone(),
+                values: Vec::new(),
+            }
+        };
         let mut trial_points = self.committed_points.to_vec();
 
         let t0 = Instant::now();
-        let responses = evaluate_elements(
+        let threads = element_threads(model.settings.threads);
+        let slots = self.dofs.slots(model, &self.pattern);
+        let elements = evaluate_elements(
             model,
             x,
             self.committed_points,
             &mut trial_points,
-            element_threads(model.settings.threads),
+            threads,
+            with_jacobian,
         )?;
-        for (hex, ElementResponse { force, stiffness }) in model.mesh.hexes.iter().zip(&responses) {
+        for (hex, force) in model.mesh.hexes.iter().zip(elements.force.chunks(24)) {
             for (a, &na) in hex.iter().enumerate() {
                 for i in 0..3 {
                     f_int[3 * na + i] += force[3 * a + i];
-                    for (b, &nb) in hex.iter().enumerate() {
-                        for j in 0..3 {
-                            jac.add(3 * na + i, 3 * nb + j, stiffness[(3 * a + i, 3 * b + j)]);
-                        }
-                    }
                 }
             }
+        }
+        if with_jacobian {
+            slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
         }
         times.elements += t0.elapsed().as_secs_f64();
 
@@ -264,6 +358,7 @@ impl IncrementContext<'_> {
             let pose = &force_control::shifted(&self.poses[c], model, self.dofs, c, x);
             let mut list = Vec::with_capacity(contact.candidates.len());
             for (k, &node) in contact.candidates.iter().enumerate() {
+                let pair_slots = &slots.contact[c][k];
                 let committed = &self.committed_contact[c][k];
                 let xn = model.mesh.nodes[node]
                     + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
@@ -317,8 +412,10 @@ impl IncrementContext<'_> {
                 };
                 for i in 0..3 {
                     residual[3 * node + i] += result.f_equi[i];
-                    for j in 0..3 {
-                        jac.add(3 * node + i, 3 * node + j, result.equi_x[(i, j)]);
+                }
+                if with_jacobian {
+                    for (ij, &slot) in pair_slots[0].iter().enumerate() {
+                        jac.values[slot] += result.equi_x[(ij / 3, ij % 3)];
                     }
                 }
                 if let Some(l) = lam_dof {
@@ -336,13 +433,18 @@ impl IncrementContext<'_> {
                     }
                     for i in 0..3 {
                         residual[l + i] = result.f_suppl[i];
-                        for j in 0..3 {
-                            jac.add(3 * node + i, l + j, result.equi_lambda[(i, j)]);
-                            jac.add(l + i, 3 * node + j, result.suppl_x[(i, j)]);
-                            jac.add(l + i, l + j, result.suppl_lambda[(i, j)]);
-                        }
                     }
-                    force_control::add_node_column(&mut jac, model, self.dofs, c, node, l, &result);
+                    if with_jacobian {
+                        for ij in 0..9 {
+                            let (i, j) = (ij / 3, ij % 3);
+                            jac.values[pair_slots[1][ij]] += result.equi_lambda[(i, j)];
+                            jac.values[pair_slots[2][ij]] += result.suppl_x[(i, j)];
+                            jac.values[pair_slots[3][ij]] += result.suppl_lambda[(i, j)];
+                        }
+                        force_control::add_node_column(
+                            &mut jac, model, self.dofs, c, node, l, &result,
+                        );
+                    }
                 }
                 list.push((result, proj));
             }
@@ -372,7 +474,11 @@ impl IncrementContext<'_> {
             unit[d] = true;
             residual[d] = value;
         }
-        jac.set_unit_rows(&unit);
+        if with_jacobian {
+            jac.set_unit_rows(&unit);
+        } else {
+            jac.values = Vec::new();
+        }
         Ok(Evaluation {
             residual,
             jacobian: jac,
@@ -397,6 +503,7 @@ fn far_from_tool(lambda: &Vec3, r: f64) -> NodalContact {
         suppl_x: Mat3::zeros(),
         suppl_lambda: -Mat3::identity() / r,
         slip_increment: Vec3::zeros(),
+        tangential_force: Vec3::zeros(),
     }
 }
 
@@ -457,4 +564,134 @@ fn implicit_mu(
     }
     params.dmu_dx = dwork_dx * (0.5 * slope);
     params.dmu_dlambda = delta_t * (0.5 * slope);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::{ContactStatus, FrictionLaw};
+    use crate::element::StrainTheory;
+    use crate::geometry::Cylinder;
+    use crate::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
+    use crate::mesh::Mesh;
+    use crate::tool::schedule::Schedule;
+    use crate::tool::{ForceControl, ScalarSchedule, Tool};
+
+    /// A Hill48 strip (finite strain) under a rough cylinder pushed into it, optionally
+    /// force-controlled, and the unknowns of a state where the cylinder presses the strip:
+    /// top bulged into the roller, sheared sideways, multipliers of mixed sign.
+    fn pressed_strip(force_controlled: bool) -> (Model, Vec<f64>) {
+        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(6.0, 1.0, 1.0), [12, 1, 3]).unwrap();
+        let material = ElastoPlastic::new(
+            LinearElastic::new(70e3, 0.33).unwrap(),
+            Hill48::from_lankford(0.7, 1.3, 2.1).unwrap(),
+            Hardening::swift(500.0, 0.01, 0.22).unwrap(),
+        );
+        let mut model = Model::new(mesh, Arc::new(material)).unwrap();
+        let cylinder = Cylinder::new(Vec3::new(3.0, 0.0, 6.0), Vec3::y(), 5.0).unwrap();
+        let mut tool = Tool::new("roller", Arc::new(cylinder));
+        tool.schedule = Schedule::new(vec![(0.0, Vec3::zeros()), (1.0, Vec3::zeros())]).unwrap();
+        tool.friction = FrictionLaw::coulomb(0.2).unwrap();
+        if force_controlled {
+            tool.force_control =
+                Some(ForceControl::new(-Vec3::z(), ScalarSchedule::constant(50.0)).unwrap());
+        }
+        model.add_tool(tool, "z+", None).unwrap();
+        model
+            .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
+            .unwrap();
+        model.settings.kinematics = StrainTheory::Finite;
+        let dofs = DofMap::new(&model);
+        let mut x = vec![0.0; dofs.n_dofs];
+        for (node, p) in model.mesh.nodes.iter().enumerate() {
+            let squeeze = (-(p.x - 3.0).powi(2)).exp() * p.z;
+            x[3 * node] = 0.01 * p.z * p.x.sin();
+            x[3 * node + 2] = 0.04 * squeeze;
+        }
+        for (k, v) in x[3 * dofs.n_nodes..].iter_mut().enumerate() {
+            *v = 20.0 * ((k as f64) * 0.7).sin();
+        }
+        // The force-controlled tool's offset stays where the schedule puts it.
+        for s in dofs.tool_offset.iter().flatten() {
+            x[*s] = 0.0;
+        }
+        (model, x)
+    }
+
+    /// A residual-only evaluation gives, bit for bit, everything a full one gives but the
+    /// Jacobian (residual, forces, support forces, point states, contact output): so the
+    /// line search, which judges a trial by these alone, takes the same decisions with it.
+    /// The full evaluation's Jacobian is complete, the residual-only one's empty.
+    #[test]
+    fn residual_only_evaluation_equals_the_full_one_but_the_jacobian() {
+        for force_controlled in [false, true] {
+            let (model, x) = pressed_strip(force_controlled);
+            let dofs = DofMap::new(&model);
+            let pattern = Arc::new(dofs.pattern(&model));
+            let mut is_fixed = vec![false; dofs.n_dofs];
+            for bc in &model.dirichlet {
+                for &node in &bc.nodes {
+                    is_fixed[3 * node + bc.component] = true;
+                }
+            }
+            let points = vec![PointState::default(); model.mesh.hexes.len() * 8];
+            let contact: Vec<Vec<ContactNodeState>> = model
+                .contacts
+                .iter()
+                .map(|c| {
+                    let pose = c.tool.pose(1.0);
+                    c.candidates
+                        .iter()
+                        .map(|&node| ContactNodeState {
+                            x_ref_local: pose.to_local(&model.mesh.nodes[node]),
+                            mu: 0.2,
+                            ..Default::default()
+                        })
+                        .collect()
+                })
+                .collect();
+            let ctx = IncrementContext {
+                model: &model,
+                dofs: &dofs,
+                pattern,
+                time: 1.0,
+                poses: model.contacts.iter().map(|c| c.tool.pose(1.0)).collect(),
+                committed_points: &points,
+                committed_contact: &contact,
+                frozen: None,
+                is_fixed: &is_fixed,
+                forced: None,
+            };
+            let mut times = PhaseTimes::default();
+            let full = ctx.evaluate(&x, &mut times).unwrap();
+            let residual_only = ctx.evaluate_residual(&x, &mut times).unwrap();
+            let statuses: Vec<ContactStatus> =
+                full.nodal[0].iter().map(|(r, _)| r.status).collect();
+            assert!(
+                statuses.iter().any(|s| s.is_active()),
+                "contact must be active"
+            );
+            assert!(
+                full.trial_points.iter().any(|p| p.eq_plastic_strain > 0.0),
+                "the strip must yield"
+            );
+            assert!(full.has_jacobian() && !residual_only.has_jacobian());
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&full.residual), bits(&residual_only.residual));
+            assert_eq!(bits(&full.f_int), bits(&residual_only.f_int));
+            assert_eq!(bits(&full.f_ext), bits(&residual_only.f_ext));
+            assert_eq!(
+                bits(&full.support_forces),
+                bits(&residual_only.support_forces)
+            );
+            assert_eq!(full.trial_points, residual_only.trial_points);
+            assert_eq!(
+                statuses,
+                residual_only.nodal[0]
+                    .iter()
+                    .map(|(r, _)| r.status)
+                    .collect::<Vec<_>>()
+            );
+        }
+    }
 }

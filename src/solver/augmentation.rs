@@ -1,30 +1,45 @@
 //! Default augmentation (or penalty) parameter r of each contact node, from the body's
 //! stiffness and the element size, so that a user tunes no magic number.
 //!
-//! The augmented multiplier `sigma = lambda + r g` adds a force and a gap; it weighs them
-//! alike when r is the stiffness with which the body resists moving the node normal to its
-//! surface, i.e. the size of the node's diagonal entry of K. For a node on the contact
-//! surface that is
+//! The augmented multiplier `sigma = lambda + r g` adds a force and a gap. Its solution does
+//! not depend on r, Newton's path does: the status of a node (gap, stick, slip) follows the
+//! sign of `sigma_n`, so with r far above the stiffness that actually resists the node's
+//! motion a gap error of round-off size flips the status of a barely touching node, and the
+//! active-set search chatters; with r far below it the multiplier rows dominate and the gap
+//! closes slowly. The stiffness a sheet node sees when a tool pushes it is the membrane
+//! stiffness of the layer under it, not the through-thickness stiffness of its column. The
+//! default is that membrane stiffness shared out by tributary area:
 //!
 //! ```text
-//! r_a = M * sum over contact faces f at a of  A_{a,f} / h_f,   h_f = V_e / A_f
+//! r_a = E * sum over contact faces f at a of  (A_{a,f} / A_f) h_f,   h_f = V_e / A_f
 //! ```
 //!
-//! with `M = lambda + 2 mu` the P-wave modulus (first diagonal entry of the elastic tangent),
-//! `A_{a,f} = A_f / 4` the node's share of face f and `h_f` the height of the face's element
-//! normal to it (element volume over face area): the stiffness `M A / h` of the column of
-//! material under the node. On a mesh of cubes of side h this is `M h` at an interior face
-//! node (the former default `M sqrt(A)`), and on flat elements of thickness t and width L it
-//! is `M L^2 / t`, which `M sqrt(A) = M L` underestimates by L / t. A candidate on no contact
-//! face (a lone node) gets `M V_e^(1/3)` from its elements. Cost O(elements).
+//! with `E` Young's modulus (from the elastic tangent), `A_{a,f} = A_f / 4` the node's share
+//! of face f and `h_f` the height of the face's element normal to it (element volume over
+//! face area). An interior node of a sheet of one layer of thickness t gets `E t` (the value
+//! the square cup script used to pick by hand), an edge node `E t / 2`, a corner `E t / 4`;
+//! a node on a block of cubes of side h gets `E h`. Measured on the square cup, the former
+//! default, the column stiffness `M A / h` (M the P-wave modulus), was about 20 times E t on
+//! 3 x 3 x 0.81 mm cells and made the active-set search oscillate (BENCHMARKS.md, issue 14).
+//! A candidate on no contact face (a lone node) gets `E V_e^(1/3)` from its elements.
+//! Cost O(elements).
 
 use crate::element::{Element, Hex8};
+use crate::material::Tangent;
 use crate::mesh::{quad_area, Mesh, HEX_FACES};
 use crate::Result;
 use std::collections::HashMap;
 
-/// r per candidate (same order as `candidates`), for P-wave modulus `modulus`.
-pub fn default_r(mesh: &Mesh, modulus: f64, candidates: &[usize]) -> Result<Vec<f64>> {
+/// Young's modulus of an isotropic elastic tangent (Voigt order xx, yy, zz, ...):
+/// `E = mu (3 lambda + 2 mu) / (lambda + mu)` with `lambda = C_01`, `mu = (C_00 - C_01) / 2`.
+pub fn young_modulus(c: &Tangent) -> f64 {
+    let lambda = c[(0, 1)];
+    let mu = 0.5 * (c[(0, 0)] - c[(0, 1)]);
+    mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu)
+}
+
+/// r per candidate (same order as `candidates`), for Young's modulus `young`.
+pub fn default_r(mesh: &Mesh, young: f64, candidates: &[usize]) -> Result<Vec<f64>> {
     let key = |f: &[usize; 4]| {
         let mut k = *f;
         k.sort_unstable();
@@ -48,14 +63,14 @@ pub fn default_r(mesh: &Mesh, modulus: f64, candidates: &[usize]) -> Result<Vec<
                 let area = quad_area(&face.map(|n| mesh.nodes[n]));
                 let height = volume / area;
                 for &n in face {
-                    r[n] += modulus * 0.25 * area / height;
+                    r[n] += young * 0.25 * height;
                 }
             }
         }
     }
     Ok(candidates
         .iter()
-        .map(|&n| if r[n] > 0.0 { r[n] } else { modulus * lone[n] })
+        .map(|&n| if r[n] > 0.0 { r[n] } else { young * lone[n] })
         .collect())
 }
 
@@ -63,10 +78,11 @@ pub fn default_r(mesh: &Mesh, modulus: f64, candidates: &[usize]) -> Result<Vec<
 mod tests {
     use super::*;
     use crate::geometry::Vec3;
+    use crate::material::{LinearElastic, Material};
 
     #[test]
-    fn column_stiffness_on_cubes_and_on_flat_elements() {
-        // Cubes of side 0.5: M h at interior face nodes, M h / 2 at edges, M h / 4 at corners.
+    fn membrane_stiffness_on_cubes_and_on_a_sheet() {
+        // Cubes of side 0.5: E h at interior face nodes, E h / 2 at edges, E h / 4 at corners.
         let mesh = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 2.0, 1.0), [4, 4, 2]).unwrap();
         let top = mesh.node_set("z+").unwrap().to_vec();
         let r = default_r(&mesh, 10.0, &top).unwrap();
@@ -81,15 +97,23 @@ mod tests {
         assert!((at(1.0, 1.0) - 5.0).abs() < 1e-12);
         assert!((at(0.0, 1.0) - 2.5).abs() < 1e-12);
         assert!((at(0.0, 0.0) - 1.25).abs() < 1e-12);
-        // Flat elements 0.5 x 0.5 x 0.05: M A / t = 10 * 0.25 / 0.05 at interior nodes,
-        // ten times the cube value, as the stiffness of the thin layer.
-        let thin = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 2.0, 0.1), [4, 4, 2]).unwrap();
+        // A sheet of one layer 0.1 thick on 0.5 x 0.5 cells: E t at interior nodes whatever
+        // the cell size (the square cup's hand-picked value).
+        let thin = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 2.0, 0.1), [4, 4, 1]).unwrap();
         let top = thin.node_set("z+").unwrap().to_vec();
         let r = default_r(&thin, 10.0, &top).unwrap();
         let max = r.iter().cloned().fold(0.0, f64::max);
-        assert!((max - 50.0).abs() < 1e-9, "{max}");
-        // A lone node: M times the cube root of its element's volume.
+        assert!((max - 1.0).abs() < 1e-12, "{max}");
+        // A lone node: E times the cube root of its element's volume.
         let r = default_r(&mesh, 10.0, &[0]).unwrap();
         assert!((r[0] - 10.0 * 0.125f64.cbrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn young_modulus_from_the_elastic_tangent() {
+        let m = LinearElastic::new(210e3, 0.3).unwrap();
+        let e = young_modulus(&m.elastic_tangent());
+        // Round-off of lambda and mu formed from E and nu.
+        assert!((e - 210e3).abs() < 1e-9 * 210e3, "{e}");
     }
 }

@@ -14,7 +14,8 @@
 //! `float_roundtrip` parser, so every f64 is restored bit for bit and a restarted run
 //! repeats the uninterrupted one exactly.
 
-use super::simulation::{EnergyBalance, EnergyMemory, IncrementReport, Simulation};
+use super::energy::{EnergyBalance, EnergyMemory};
+use super::simulation::{IncrementReport, Simulation};
 use super::step_control::StepController;
 use crate::contact::ContactNodeState;
 use crate::material::PointState;
@@ -52,19 +53,54 @@ pub struct Fingerprint {
     pub unknowns: usize,
     /// (tool name, candidate nodes) per tool.
     pub tools: Vec<(String, Vec<usize>)>,
+    /// FNV-1a hash of the node coordinates (bits) and the connectivity, as 16 hex digits.
+    #[serde(default)]
+    pub mesh_hash: String,
+    /// FNV-1a hash of each tool's surface description, as 16 hex digits.
+    #[serde(default)]
+    pub tool_hashes: Vec<String>,
+}
+
+/// 64-bit FNV-1a, written as 16 hex digits (JSON numbers would lose the high bits).
+/// O(bytes).
+fn fnv1a(bytes: impl IntoIterator<Item = u8>) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
 }
 
 impl Fingerprint {
     fn of(sim: &Simulation) -> Self {
+        let mesh = &sim.model.mesh;
+        let coordinates = mesh
+            .nodes
+            .iter()
+            .flat_map(|p| [p.x, p.y, p.z])
+            .flat_map(|v| v.to_bits().to_le_bytes());
+        let connectivity = mesh
+            .hexes
+            .iter()
+            .flatten()
+            .flat_map(|&n| (n as u64).to_le_bytes());
         Fingerprint {
-            nodes: sim.model.mesh.nodes.len(),
-            elements: sim.model.mesh.hexes.len(),
+            nodes: mesh.nodes.len(),
+            elements: mesh.hexes.len(),
             unknowns: sim.unknowns().len(),
             tools: sim
                 .model
                 .contacts
                 .iter()
                 .map(|c| (c.tool.name.clone(), c.candidates.clone()))
+                .collect(),
+            mesh_hash: fnv1a(coordinates.chain(connectivity)),
+            tool_hashes: sim
+                .model
+                .contacts
+                .iter()
+                .map(|c| fnv1a(c.tool.surface.describe().into_bytes()))
                 .collect(),
         }
     }
@@ -83,6 +119,9 @@ pub struct Checkpoint {
     pub history: Vec<IncrementReport>,
     /// Times of the VTK frames the run had written when the checkpoint was taken.
     pub frame_times: Vec<f64>,
+    /// Values the script kept (`sim.keep`), restored with the state.
+    #[serde(default)]
+    pub script: serde_json::Map<String, serde_json::Value>,
 }
 
 impl Checkpoint {
@@ -102,6 +141,7 @@ impl Checkpoint {
             history: sim.history.clone(),
             state,
             frame_times,
+            script: serde_json::Map::new(),
         }
     }
 
@@ -126,7 +166,14 @@ impl Checkpoint {
     /// Makes the checkpoint's state the committed state of `sim`, after checking that
     /// `sim`'s model is the one the checkpoint was taken from.
     pub fn restore(self, sim: &mut Simulation) -> Result<()> {
-        let here = Fingerprint::of(sim);
+        let mut here = Fingerprint::of(sim);
+        // Checkpoints of earlier versions have no hashes: sizes and names are checked.
+        if self.model.mesh_hash.is_empty() {
+            here.mesh_hash.clear();
+        }
+        if self.model.tool_hashes.is_empty() {
+            here.tool_hashes.clear();
+        }
         if here != self.model {
             let what = if here.nodes != self.model.nodes || here.elements != self.model.elements {
                 format!(
@@ -144,6 +191,22 @@ impl Checkpoint {
                     "tools: {:?} in the checkpoint, {:?} in the script",
                     self.model.tools.iter().map(|t| &t.0).collect::<Vec<_>>(),
                     here.tools.iter().map(|t| &t.0).collect::<Vec<_>>()
+                )
+            } else if here.mesh_hash != self.model.mesh_hash {
+                format!(
+                    "model.mesh_hash: {} in the checkpoint, {} for the script's mesh (node coordinates or connectivity differ)",
+                    self.model.mesh_hash, here.mesh_hash
+                )
+            } else if here.tool_hashes != self.model.tool_hashes {
+                let c = here
+                    .tool_hashes
+                    .iter()
+                    .zip(&self.model.tool_hashes)
+                    .position(|(a, b)| a != b)
+                    .unwrap_or(0);
+                format!(
+                    "model.tool_hashes[{c}]: the surface of tool '{}' differs from the checkpoint's",
+                    here.tools.get(c).map_or("", |t| t.0.as_str())
                 )
             } else {
                 "contact candidates or unknowns differ (enforcement, node sets)".to_string()
@@ -181,6 +244,7 @@ impl Checkpoint {
                 )));
             }
         }
+        self.validate(sim)?;
         if s.time > sim.model.settings.end_time * (1.0 + 1e-12) {
             return Err(Error::Input(format!(
                 "the checkpoint's time {} is past the script's end time {}",
@@ -190,6 +254,155 @@ impl Checkpoint {
         sim.history = self.history;
         sim.restore_state(self.state);
         sim.clear_rollback();
+        Ok(())
+    }
+}
+
+impl Checkpoint {
+    /// Checks every value of the state against what a converged state can hold: finite
+    /// numbers, displacements within 1000 times the mesh's size, multipliers and stresses
+    /// finite, mu, frictional work, slip, equivalent plastic strain >= 0, det F > 0, a
+    /// positive next increment. The error names the field (`state.contact[0][12].mu`) and
+    /// its value. A checkpoint is JSON that a person can edit: this keeps an edited or
+    /// damaged file from starting a run from a state no increment could have produced.
+    /// O(size of the state).
+    fn validate(&self, sim: &Simulation) -> Result<()> {
+        let s = &self.state;
+        let refuse = |field: String, value: f64, requirement: &str| {
+            Err(Error::Input(format!(
+                "the checkpoint's {field} = {value} {requirement} (the file was edited or is damaged)"
+            )))
+        };
+        let finite = |field: &dyn Fn() -> String, v: f64| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                refuse(field(), v, "must be finite")
+            }
+        };
+        let non_negative = |field: &dyn Fn() -> String, v: f64| {
+            if v >= 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                refuse(field(), v, "must be finite and >= 0")
+            }
+        };
+        let mesh = &sim.model.mesh;
+        let (lo, hi) = mesh.nodes.iter().fold(
+            (
+                crate::geometry::Vec3::repeat(f64::INFINITY),
+                crate::geometry::Vec3::repeat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        let size = (hi - lo).norm().max(f64::MIN_POSITIVE);
+        let bound = 1e3 * size;
+        non_negative(&|| "state.time".into(), s.time)?;
+        let n_u = 3 * mesh.nodes.len();
+        for (i, &v) in s.x.iter().enumerate() {
+            if i < n_u {
+                if !(v.abs() <= bound) {
+                    return refuse(
+                        format!(
+                            "state.x[{i}] (displacement {} of node {})",
+                            ["x", "y", "z"][i % 3],
+                            i / 3
+                        ),
+                        v,
+                        &format!(
+                            "must be finite and within +-{bound:e} (1000 times the mesh's size)"
+                        ),
+                    );
+                }
+            } else {
+                finite(&|| format!("state.x[{i}] (a multiplier)"), v)?;
+            }
+        }
+        for (p, point) in s.points.iter().enumerate() {
+            let field = |name: &str| format!("state.points[{p}].{name}");
+            for (name, values) in [
+                ("stress", point.stress.as_slice()),
+                ("strain", point.strain.as_slice()),
+                ("plastic_strain", point.plastic_strain.as_slice()),
+                ("log_stress", point.log_stress.as_slice()),
+                (
+                    "deformation_gradient",
+                    point.deformation_gradient.as_slice(),
+                ),
+            ] {
+                for (i, &v) in values.iter().enumerate() {
+                    finite(&|| format!("{}[{i}]", field(name)), v)?;
+                }
+            }
+            non_negative(&|| field("eq_plastic_strain"), point.eq_plastic_strain)?;
+            finite(&|| field("plastic_dissipation"), point.plastic_dissipation)?;
+            let det = point.deformation_gradient.determinant();
+            if !(det > 0.0) {
+                return refuse(
+                    format!("determinant of {}", field("deformation_gradient")),
+                    det,
+                    "must be > 0",
+                );
+            }
+        }
+        for (c, nodes) in s.contact.iter().enumerate() {
+            for (k, n) in nodes.iter().enumerate() {
+                let field = |name: &str| format!("state.contact[{c}][{k}].{name}");
+                for (name, v) in [
+                    ("lambda", n.lambda),
+                    ("x_ref_local", n.x_ref_local),
+                    ("normal", n.normal),
+                ] {
+                    for (i, &x) in v.iter().enumerate() {
+                        finite(&|| format!("{}[{i}]", field(name)), x)?;
+                    }
+                }
+                finite(&|| field("gap"), n.gap)?;
+                finite(&|| field("theta"), n.theta)?;
+                non_negative(&|| field("mu"), n.mu)?;
+                non_negative(&|| field("work"), n.work)?;
+                non_negative(&|| field("slip"), n.slip)?;
+                if let Some(h) = n.hint {
+                    finite(&|| field("hint.u"), h.u)?;
+                    finite(&|| field("hint.v"), h.v)?;
+                }
+            }
+        }
+        let e = &s.energy;
+        for (name, v) in [
+            ("tool_work", e.tool_work),
+            ("load_work", e.load_work),
+            ("support_work", e.support_work),
+            ("elastic_energy", e.elastic_energy),
+            ("plastic_dissipation", e.plastic_dissipation),
+        ] {
+            finite(&|| format!("state.energy.{name}"), v)?;
+        }
+        for (c, &v) in e.frictional_dissipation.iter().enumerate() {
+            finite(&|| format!("state.energy.frictional_dissipation[{c}]"), v)?;
+        }
+        if !(s.controller.dt > 0.0 && s.controller.dt.is_finite()) {
+            return refuse(
+                "state.controller.dt".into(),
+                s.controller.dt,
+                "must be finite and > 0",
+            );
+        }
+        if let Some((dt, du)) = &s.last_step {
+            finite(&|| "state.last_step.dt".into(), *dt)?;
+            if du.len() != n_u {
+                return Err(Error::Input(format!(
+                    "the checkpoint's state.last_step holds {} values, the model has {n_u} displacements",
+                    du.len()
+                )));
+            }
+            for (i, &v) in du.iter().enumerate() {
+                finite(&|| format!("state.last_step[{i}]"), v)?;
+            }
+        }
+        for (i, &t) in self.frame_times.iter().enumerate() {
+            non_negative(&|| format!("frame_times[{i}]"), t)?;
+        }
         Ok(())
     }
 }

@@ -64,6 +64,8 @@ pub struct SolverSettings {
     /// Eliminate the multipliers of single-pair, unconstrained contact nodes before the
     /// linear solve (same Newton iterates, smaller factorization; see `condense`).
     pub eliminate_multipliers: bool,
+    /// The sparse factorization of each Newton step (see `linear`).
+    pub linear_solver: super::linear::LinearSolverKind,
     /// Small strain (B-bar hexahedra, the default) or finite strain (total-Lagrangian
     /// F-bar hexahedra, Lagrangian log-strain material update).
     pub kinematics: crate::element::StrainTheory,
@@ -92,10 +94,11 @@ impl Default for SolverSettings {
             max_cutbacks: 4,
             contact: ContactSettings::default(),
             eliminate_multipliers: true,
+            linear_solver: Default::default(),
             kinematics: crate::element::StrainTheory::Small,
             fbar: true,
             stepping: Default::default(),
-            extrapolate: false,
+            extrapolate: true,
             threads: 0,
         }
     }
@@ -196,10 +199,10 @@ impl Model {
         let areas = self.mesh.tributary_areas(&candidates)?;
         let r = match r {
             Some(r) => vec![r; candidates.len()],
-            // The stiffness of the column of material under each node (see `augmentation`).
+            // The membrane stiffness of the layer under each node (see `augmentation`).
             None => super::augmentation::default_r(
                 &self.mesh,
-                self.material.elastic_tangent()[(0, 0)],
+                super::augmentation::young_modulus(&self.material.elastic_tangent()),
                 &candidates,
             )?,
         };

@@ -4,11 +4,13 @@
 //! leaves the last converged state untouched.
 
 use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use super::energy::{EnergyBalance, EnergyMemory};
+use super::newton::{IterationRecord, Trial};
 use super::checkpoint::SavedState;
 use super::condense::Condenser;
-use super::cycling::{CyclingMonitor, CyclingNode};
+use super::cycling::CyclingNode;
 use super::force_control;
-use super::linear::{FaerLu, LinearSolver};
+use super::linear::{LinearSolver, Solver};
 use super::model::Model;
 use super::sparse::SparsePattern;
 use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
@@ -19,26 +21,6 @@ use crate::material::PointState;
 use crate::{Error, Result};
 use std::collections::VecDeque;
 use std::sync::Arc;
-use std::time::Instant;
-
-/// Consecutive merit increases that count as divergence.
-const DIVERGENCE_ITERATIONS: usize = 3;
-/// Halvings of the line search (smallest step 1/16 of the Newton step).
-const LINE_SEARCH_CUTS: usize = 4;
-/// How many times a converged frozen state may be released and frozen again in one
-/// increment (see `cycling`); after that the free law alone decides.
-const MAX_RELEASES: usize = 3;
-
-/// One Newton iteration's residual norms.
-#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
-pub struct IterationRecord {
-    /// Force residual (2-norm over free displacement dofs) divided by the reference force.
-    pub force_rel: f64,
-    /// Force residual 2-norm (force units).
-    pub force: f64,
-    /// Contact residual (max |F_suppl|, length units).
-    pub contact: f64,
-}
 
 /// What one converged increment did.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -75,17 +57,6 @@ pub struct IncrementReport {
     pub warnings: Vec<String>,
 }
 
-/// A converged Newton solve of one increment, not yet committed.
-struct Trial {
-    x: Vec<f64>,
-    eval: Evaluation,
-    iterations: usize,
-    residuals: Vec<IterationRecord>,
-    times: PhaseTimes,
-    cycling: Vec<CyclingNode>,
-    line_search_cuts: usize,
-}
-
 /// Failures after which a smaller increment may succeed.
 fn retryable(err: &Error) -> bool {
     matches!(err, Error::NoConvergence(_) | Error::LinearSolver(_))
@@ -104,29 +75,33 @@ fn bare(err: &Error) -> String {
 /// Model plus its evolving, committed solution.
 pub struct Simulation {
     pub model: Model,
-    dofs: DofMap,
-    pattern: Arc<SparsePattern>,
-    is_fixed: Vec<bool>,
-    linear: FaerLu,
-    condenser: Option<Condenser>,
+    pub(super) dofs: DofMap,
+    pub(super) pattern: Arc<SparsePattern>,
+    pub(super) is_fixed: Vec<bool>,
+    pub(super) linear: Solver,
+    pub(super) condenser: Option<Condenser>,
     /// Committed unknowns [u, lambda].
-    x: Vec<f64>,
-    points: Vec<PointState>,
-    contact: Vec<Vec<ContactNodeState>>,
-    time: f64,
-    increments_done: usize,
+    pub(super) x: Vec<f64>,
+    pub(super) points: Vec<PointState>,
+    pub(super) contact: Vec<Vec<ContactNodeState>>,
+    pub(super) time: f64,
+    pub(super) increments_done: usize,
     pub history: Vec<IncrementReport>,
     pub phase_times: PhaseTimes,
-    energy: EnergyBalance,
-    energy_memory: EnergyMemory,
-    controller: StepController,
+    pub(super) energy: EnergyBalance,
+    pub(super) energy_memory: EnergyMemory,
+    pub(super) controller: StepController,
     /// Schedule breakpoints and the end time: adaptive increments land on them.
-    stops: Vec<f64>,
+    pub(super) stops: Vec<f64>,
     /// Committed states before the last increments, for `rollback`.
-    saved: VecDeque<SavedState>,
+    pub(super) saved: VecDeque<SavedState>,
     /// Last converged increment (dt, change of the displacements), for the extrapolating
     /// predictor.
-    last_step: Option<(f64, Vec<f64>)>,
+    pub(super) last_step: Option<(f64, Vec<f64>)>,
+    /// Stop request polled between Newton iterations (see `crate::interrupt`).
+    pub(super) interrupt: crate::interrupt::Interrupt,
+    /// Whether the run has explained contact-status cycling to the user (once per run).
+    pub(super) cycling_explained: bool,
 }
 
 impl Simulation {
@@ -145,7 +120,8 @@ impl Simulation {
         }
         force_control::check(&model)?;
         let dofs = DofMap::new(&model);
-        let pattern = Arc::new(dofs.pattern(&model));
+        let groups = super::condense::elimination_groups(&model, &dofs);
+        let pattern = Arc::new(dofs.pattern(&model).with_groups(groups));
         let mut is_fixed = vec![false; dofs.n_dofs];
         for bc in &model.dirichlet {
             for &node in &bc.nodes {
@@ -195,7 +171,7 @@ impl Simulation {
             dofs,
             pattern,
             is_fixed,
-            linear: FaerLu::default(),
+            linear: Solver::new(model.settings.linear_solver),
             points,
             contact,
             time: 0.0,
@@ -207,6 +183,8 @@ impl Simulation {
                 ..Default::default()
             },
             last_step: None,
+            interrupt: crate::interrupt::Interrupt::new(),
+            cycling_explained: false,
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -285,7 +263,7 @@ impl Simulation {
         Ok(r)
     }
 
-    fn context(
+    pub(super) fn context(
         &self,
         time: f64,
         frozen: Option<Vec<Vec<Option<FrozenFrame>>>>,
@@ -309,56 +287,9 @@ impl Simulation {
         }
     }
 
-    /// Solves J dx = -R, through the condensed system when multipliers are eliminated.
-    pub fn newton_step(&self, eval: &Evaluation, linear: &mut FaerLu) -> Result<Vec<f64>> {
-        // Tool offsets couple to every node of their tool: kept out of the sparse LU.
-        let border: Vec<usize> = self.dofs.tool_offset.iter().flatten().copied().collect();
-        match &self.condenser {
-            Some(c) => c.solve(&eval.jacobian, &eval.residual, &border, linear),
-            None => {
-                let mut rhs: Vec<f64> = eval.residual.iter().map(|v| -v).collect();
-                linear.solve_bordered(&eval.jacobian, &mut rhs, &border)?;
-                Ok(rhs)
-            }
-        }
-    }
-
-    /// The contraction test for a full Newton step `dx` that raised the merit `|R|`, from
-    /// the state evaluated as `at_x` to the one evaluated as `trial`: the step is good if
-    /// it changed no contact status (a smooth step; otherwise the merit decides) and the
-    /// next Newton correction `dx' = -J(x + dx)⁻¹ R(x + dx)` is shorter,
-    /// `Θ = |dx'| / |dx| <= 3/4` (displacement parts; Θ is the contraction factor of
-    /// Newton's convergence theory, Deuflhard, *Newton Methods for Nonlinear Problems*,
-    /// 2004, sec. 2.1). Returns `dx'` if so, for the next iteration.
-    ///
-    /// Why: the merit `|R|` weighs each mode by its stiffness. On a thin body the
-    /// membrane stiffness exceeds the bending stiffness by `(L/t)²`, so the membrane
-    /// forces of a first bending iterate (stretch `θ²/2` at rotation `θ`) raise `|R|` a
-    /// hundred- to ten-thousandfold although the step is good: on a 100 x 10 x 1 steel
-    /// cantilever under 1 N, `|R|` goes 0.43 -> 60 N while `|dx|` goes 0.81 -> 6e-4 mm.
-    /// Backtracked steps then crawl and the run stopped as diverging; full steps converge
-    /// in 3 iterations. Corrections measure the error in displacements, free of that
-    /// scaling. The simplified correction `J(x)⁻¹ R(x + dx)` would be cheaper but misses
-    /// the tension stiffening that the first step brings in (`Θ = 53` on a fine mesh that
-    /// then converges quadratically). Cost: none when accepted (`dx'` is the next step).
-    fn newton_contraction(
-        &self,
-        at_x: &Evaluation,
-        trial: &Evaluation,
-        dx: &[f64],
-        linear: &mut FaerLu,
-    ) -> Result<Option<Vec<f64>>> {
-        let smooth = at_x.nodal.iter().zip(&trial.nodal).all(|(a, b)| {
-            a.iter()
-                .zip(b)
-                .all(|((na, _), (nb, _))| na.status == nb.status)
-        });
-        if !smooth {
-            return Ok(None);
-        }
-        let n_u = 3 * self.dofs.n_nodes;
-        let next = self.newton_step(trial, linear)?;
-        Ok((norm(&next[..n_u]) <= 0.75 * norm(&dx[..n_u])).then_some(next))
+    /// The multiplier elimination, when there is one.
+    pub fn condenser(&self) -> Option<&Condenser> {
+        self.condenser.as_ref()
     }
 
     /// Multiplier unknowns eliminated before each linear solve.
@@ -368,7 +299,7 @@ impl Simulation {
 
     /// How many symbolic LU analyses were done: one per sparsity pattern, not per iteration.
     pub fn symbolic_analyses(&self) -> usize {
-        self.linear.symbolic_count
+        self.linear.symbolic_analyses()
     }
 
     /// Committed unknowns [u, lambda].
@@ -387,6 +318,7 @@ impl Simulation {
     /// to `max_cutbacks` times (the sub-increments are all in `history`). Adaptive stepping:
     /// one increment of the size the controller chose (see `step_control`).
     pub fn step(&mut self) -> Result<IncrementReport> {
+        self.check_interrupt()?;
         if self.is_finished() {
             return Err(Error::Input(format!(
                 "the simulation already reached its end time {}",
@@ -397,6 +329,24 @@ impl Simulation {
             StepMode::Fixed => self.step_fixed(),
             StepMode::Adaptive => self.step_adaptive(),
         }
+    }
+
+    /// Connects a stop request: a raised flag abandons the increment under way at its next
+    /// Newton iteration (`Error::Interrupted`); the committed state stays the last
+    /// converged one.
+    pub fn set_interrupt(&mut self, interrupt: crate::interrupt::Interrupt) {
+        self.interrupt = interrupt;
+    }
+
+    pub(super) fn check_interrupt(&self) -> Result<()> {
+        if self.interrupt.is_raised() {
+            return Err(Error::Interrupted(format!(
+                "{}; the increment from t = {} was abandoned",
+                self.interrupt.reason(),
+                self.time
+            )));
+        }
+        Ok(())
     }
 
     fn step_fixed(&mut self) -> Result<IncrementReport> {
@@ -420,6 +370,7 @@ impl Simulation {
                     }
                     return Ok(report);
                 }
+                Err(err @ Error::Interrupted(_)) => return Err(err),
                 Err(err) if retryable(&err) && cutbacks < self.model.settings.max_cutbacks => {
                     cutbacks += 1;
                     dt *= 0.5;
@@ -482,6 +433,7 @@ impl Simulation {
                     self.history.push(report.clone());
                     return Ok(report);
                 }
+                Err(err @ Error::Interrupted(_)) => return Err(err),
                 Err(err) if retryable(&err) && dt_used > dt_min * (1.0 + 1e-9) => {
                     cutbacks += 1;
                     dt = (0.5 * dt_used).max(dt_min);
@@ -534,43 +486,15 @@ impl Simulation {
             trial.residuals,
         );
         report.line_search_cuts = trial.line_search_cuts;
-        if !trial.cycling.is_empty() {
-            let nodes: Vec<String> = trial
-                .cycling
-                .iter()
-                .map(|n| {
-                    format!(
-                        "{}:{} ({} flips{})",
-                        self.model.contacts[n.tool].tool.name,
-                        n.node,
-                        n.flips,
-                        n.frozen
-                            .as_ref()
-                            .map(|s| format!(", frozen {s}"))
-                            .unwrap_or_default()
-                    )
-                })
-                .collect();
-            // A long run prints this every increment: name the first few nodes only (the
-            // full list is in the report), and the free-law residual only when statuses
-            // were frozen (otherwise it is the converged residual).
-            const SHOWN: usize = 8;
-            let more = nodes.len().saturating_sub(SHOWN);
-            let frozen = trial.cycling.iter().any(|n| n.frozen.is_some());
-            report.warnings.push(format!(
-                "contact status cycled at {} node(s): {}{}{}",
-                nodes.len(),
-                nodes[..nodes.len().min(SHOWN)].join(", "),
-                if more > 0 { format!(" and {more} more") } else { String::new() },
-                // Frozen statuses are always released before an increment is accepted, so
-                // the last residual is the free law's.
-                match report.residuals.last().filter(|_| frozen) {
-                    Some(free) => format!(
-                        "; free-law residual at the converged state: force {:.3e} relative, contact {:.3e}",
-                        free.force_rel, free.contact
-                    ),
-                    None => String::new(),
-                }
+        // Cycling is worth one explanation per run, not one line per increment: the nodes
+        // of every increment are in its report and in history.csv (cycling_nodes).
+        if !trial.cycling.is_empty() && !self.cycling_explained {
+            self.cycling_explained = true;
+            report.warnings.push(cycling_warning(
+                &self.model,
+                &trial.cycling,
+                report.index,
+                self.model.settings.stepping.anti_cycling,
             ));
         }
         report.cycling = trial.cycling;
@@ -616,395 +540,6 @@ impl Simulation {
         outcome
     }
 
-    /// Residual norms of an evaluation (the convergence measures and the merit function).
-    fn residual_record(&self, eval: &Evaluation, weights: &[f64]) -> (IterationRecord, f64, f64) {
-        let settings = &self.model.settings;
-        let n_u = 3 * self.dofs.n_nodes;
-        let force = norm(&eval.residual[..n_u]);
-        let reference = norm(&eval.f_int)
-            .max(norm(&eval.f_ext))
-            .max(settings.force_abs_tol);
-        let contact = eval.residual[n_u..]
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        // Merit: the full residual with the contact rows (lengths) scaled by r (forces). An
-        // approach row is a travel to first touch, not an error to reduce: left out.
-        let approach_rows: Vec<usize> = (0..self.model.contacts.len())
-            .filter(|&c| force_control::approaching(&self.model, c, &eval.nodal))
-            .filter_map(|c| self.dofs.tool_offset[c])
-            .collect();
-        let merit = (force * force
-            + eval.residual[n_u..]
-                .iter()
-                .zip(weights)
-                .enumerate()
-                .filter(|(i, _)| !approach_rows.contains(&(n_u + i)))
-                .map(|(_, (v, w))| (v * w).powi(2))
-                .sum::<f64>())
-        .sqrt();
-        (
-            IterationRecord {
-                force_rel: force / reference,
-                force,
-                contact,
-            },
-            merit,
-            reference,
-        )
-    }
-
-    /// Where the residual is largest: the three nodes with the largest force residual and
-    /// the contact pair with the largest constraint residual.
-    fn locate(&self, eval: &Evaluation) -> String {
-        let mut nodes: Vec<(usize, f64)> = (0..self.dofs.n_nodes)
-            .map(|n| (n, norm(&eval.residual[3 * n..3 * n + 3])))
-            .collect();
-        nodes.sort_by(|a, b| b.1.total_cmp(&a.1));
-        let mut text = format!(
-            "largest force residual at node(s) {}",
-            nodes
-                .iter()
-                .take(3)
-                .map(|(n, r)| format!("{n} ({r:.3e})"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-        let mut worst: Option<(usize, usize, f64)> = None;
-        for (c, contact) in self.model.contacts.iter().enumerate() {
-            if let Some(off) = self.dofs.lambda_offset[c] {
-                for (k, &node) in contact.candidates.iter().enumerate() {
-                    let r = norm(&eval.residual[off + 3 * k..off + 3 * k + 3]);
-                    if worst.is_none_or(|w| r > w.2) {
-                        worst = Some((c, node, r));
-                    }
-                }
-            }
-        }
-        if let Some((c, node, r)) = worst {
-            text += &format!(
-                "; largest contact residual at node {node} on tool '{}' ({r:.3e})",
-                self.model.contacts[c].tool.name
-            );
-        }
-        text
-    }
-
-    fn newton(&self, t_new: f64, linear: &mut FaerLu) -> Result<Trial> {
-        let settings = self.model.settings.clone();
-        let step = &settings.stepping;
-        let mut x = self.x.clone();
-        let frozen = match settings.contact.frame {
-            FrameUpdate::EveryIteration => None,
-            FrameUpdate::Frozen => Some(self.frozen_frames(t_new)),
-        };
-        let mut ctx = self.context(t_new, frozen);
-        let n_u = 3 * self.dofs.n_nodes;
-        let mut weights = vec![0.0; self.dofs.n_dofs - n_u];
-        for (c, contact) in self.model.contacts.iter().enumerate() {
-            if let Some(off) = self.dofs.lambda_offset[c] {
-                for (k, r) in contact.r.iter().enumerate() {
-                    weights[off - n_u + 3 * k..off - n_u + 3 * k + 3].fill(*r);
-                }
-            }
-            // A force-controlled tool's force row (a length: force error / r_s) enters the
-            // merit times r_s, as a force error; its approach row does not (see
-            // `residual_record`).
-            if let Some(s) = self.dofs.tool_offset[c] {
-                weights[s - n_u] = force_control::row_scale(&self.model, c);
-            }
-        }
-        // While a force-controlled tool's force comes on, the body's residual rises from
-        // zero for several iterations by design: there, only a residual grown a millionfold
-        // counts as divergence, not a run of increases.
-        let force_controlled = self.dofs.tool_offset.iter().any(Option::is_some);
-        let sizes: Vec<usize> = self
-            .model
-            .contacts
-            .iter()
-            .map(|c| c.candidates.len())
-            .collect();
-        let mut monitor = CyclingMonitor::new(&sizes, step.anti_cycling, step.cycle_flips);
-        let node_of = |c: usize, k: usize| self.model.contacts[c].candidates[k];
-        let mut times = PhaseTimes::default();
-        // The last increment's displacement change, scaled to this step: in forming the
-        // sheet keeps moving the way it moved, so the first iterate starts near the right
-        // contact statuses (from the committed state, Newton has to rediscover the whole
-        // active set, tens of iterations on a drawn sheet).
-        if let (true, Some((dt_last, dx))) = (settings.extrapolate, &self.last_step) {
-            let ratio = (t_new - self.time) / dt_last;
-            for (xi, d) in x[..n_u].iter_mut().zip(dx) {
-                *xi += ratio * d;
-            }
-        }
-        self.dirichlet_predictor(&ctx, t_new, &mut x, linear, &mut times)?;
-        for bc in &self.model.dirichlet {
-            let v = bc.value.value(t_new);
-            for &node in &bc.nodes {
-                x[3 * node + bc.component] = v;
-            }
-        }
-        let mut residuals = Vec::new();
-        let mut merits: Vec<f64> = Vec::new();
-        let mut iterations = 0;
-        let mut line_search_cuts = 0;
-        let mut eval = ctx.evaluate(&x, &mut times)?;
-        // Merits before a freeze belong to another problem: divergence is judged after it.
-        let mut window_start = 0;
-        let mut releases = 0;
-        // The Newton correction at `eval`, when the contraction test already solved for it.
-        let mut next_step: Option<Vec<f64>> = None;
-        loop {
-            if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
-                ctx.forced = monitor.forced();
-                eval = ctx.evaluate(&x, &mut times)?;
-                window_start = merits.len();
-                next_step = None;
-            }
-            let (rec, merit, reference) = self.residual_record(&eval, &weights);
-            residuals.push(rec);
-            merits.push(merit);
-            let cycling_note = || {
-                let r = monitor.report(node_of);
-                if r.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        "; status cycling at node(s) {:?}",
-                        r.iter().map(|n| n.node).collect::<Vec<_>>()
-                    )
-                }
-            };
-            if !(rec.force.is_finite() && rec.contact.is_finite()) {
-                return Err(Error::NoConvergence(format!(
-                    "non-finite residual at iteration {iterations}"
-                )));
-            }
-            let force_ok = rec.force <= settings.force_rel_tol * reference
-                || rec.force <= settings.force_abs_tol;
-            if force_ok && rec.contact <= settings.contact_tol {
-                // Converged with frozen statuses: only the free law's solution counts, so
-                // Newton goes on unfrozen from this state, near the solution. After the
-                // last allowed release nothing is frozen again, so no frozen state is
-                // ever accepted.
-                if ctx.forced.is_some() {
-                    releases += 1;
-                    monitor.release(releases < MAX_RELEASES);
-                    ctx.forced = None;
-                    eval = ctx.evaluate(&x, &mut times)?;
-                    window_start = merits.len();
-                    next_step = None;
-                    continue;
-                }
-                break;
-            }
-            if iterations >= settings.max_iterations {
-                return Err(Error::NoConvergence(format!(
-                    "{iterations} Newton iterations without convergence (force residual {:.3e} relative, contact residual {:.3e}); {}{}",
-                    rec.force_rel,
-                    rec.contact,
-                    self.locate(&eval),
-                    cycling_note()
-                )));
-            }
-            // Growth is measured from the first residual above the tolerance: an increment
-            // driven only by a force-controlled tool starts from a zero (or round-off) force
-            // residual, which is no scale for growth.
-            let first = residuals
-                .iter()
-                .map(|r| r.force_rel)
-                .find(|&v| v > settings.force_rel_tol)
-                .unwrap_or(f64::INFINITY);
-            let first_merit = merits.iter().copied().find(|&v| v > 0.0).unwrap_or(0.0);
-            let grew = !force_controlled
-                && merits.len() > window_start + DIVERGENCE_ITERATIONS
-                && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
-                    .windows(2)
-                    .all(|w| w[1] > w[0])
-                && merit > first_merit
-                // Growth of a force residual already below its tolerance is round-off.
-                && !force_ok;
-            if grew || (iterations >= 4 && rec.force_rel > 1e6 * first) {
-                return Err(Error::NoConvergence(format!(
-                    "Newton diverges (force residual grew to {:.3e} relative); {}{}",
-                    rec.force_rel,
-                    self.locate(&eval),
-                    cycling_note()
-                )));
-            }
-            let ts = Instant::now();
-            let dx = match next_step.take() {
-                Some(dx) => dx,
-                None => self.newton_step(&eval, linear)?,
-            };
-            times.factorization_and_solve += ts.elapsed().as_secs_f64();
-            // A step that brings a force-controlled tool to first touch is taken whole: the
-            // merit cannot judge it (its force row only starts to count once touching).
-            let approach = (0..self.model.contacts.len())
-                .any(|c| force_control::approaching(&self.model, c, &eval.nodal));
-            let mut contracted = None;
-            let mut contraction_time = 0.0;
-            let (x_new, eval_new, cuts) = self.line_search(
-                &ctx,
-                &x,
-                &dx,
-                if approach { f64::INFINITY } else { merit },
-                monitor.damping(),
-                &weights,
-                &mut |trial| {
-                    let ts = Instant::now();
-                    contracted = self.newton_contraction(&eval, trial, &dx, linear)?;
-                    contraction_time += ts.elapsed().as_secs_f64();
-                    Ok(contracted.is_some())
-                },
-                &mut times,
-            )?;
-            times.factorization_and_solve += contraction_time;
-            // A full step accepted by the contraction test may raise |R|: the merits
-            // before it are no scale for divergence.
-            if contracted.is_some() {
-                window_start = merits.len();
-            }
-            next_step = contracted;
-            line_search_cuts += cuts;
-            x = x_new;
-            eval = eval_new;
-            iterations += 1;
-        }
-        Ok(Trial {
-            x,
-            eval,
-            iterations,
-            residuals,
-            times,
-            cycling: monitor.report(node_of),
-            line_search_cuts,
-        })
-    }
-
-    /// Backtracking (Armijo) line search on the merit function |R|: the step `alpha dx` with
-    /// the first alpha in `alpha0, alpha0/2, ...` (down to `alpha0/16`) that reduces the merit
-    /// by the factor `1 - 1e-4 alpha`; failing that, the trial with the smallest merit. A
-    /// trial that inverts an element counts as an infinite merit. With the line search off,
-    /// the step `alpha0 dx` is taken. Returns the new unknowns, their evaluation and the
-    /// number of backtracking steps. A full step (`alpha0 = 1`) that fails the merit test
-    /// is still taken if `accept_full` says so (the contraction test).
-    #[allow(clippy::too_many_arguments)]
-    fn line_search(
-        &self,
-        ctx: &IncrementContext<'_>,
-        x: &[f64],
-        dx: &[f64],
-        merit0: f64,
-        alpha0: f64,
-        weights: &[f64],
-        accept_full: &mut dyn FnMut(&Evaluation) -> Result<bool>,
-        times: &mut PhaseTimes,
-    ) -> Result<(Vec<f64>, Evaluation, usize)> {
-        let trial_x =
-            |alpha: f64| -> Vec<f64> { x.iter().zip(dx).map(|(xi, d)| xi + alpha * d).collect() };
-        if !self.model.settings.stepping.line_search {
-            let xn = trial_x(alpha0);
-            let e = ctx.evaluate(&xn, times)?;
-            return Ok((xn, e, 0));
-        }
-        let mut alpha = alpha0;
-        let mut best: Option<(f64, Vec<f64>, Evaluation)> = None;
-        let mut last_err = None;
-        for cut in 0..=LINE_SEARCH_CUTS {
-            let xn = trial_x(alpha);
-            match ctx.evaluate(&xn, times) {
-                Ok(e) => {
-                    let m = self.residual_record(&e, weights).1;
-                    if m.is_finite() && m <= (1.0 - 1e-4 * alpha) * merit0 {
-                        return Ok((xn, e, cut));
-                    }
-                    if cut == 0 && alpha0 == 1.0 && m.is_finite() && accept_full(&e)? {
-                        return Ok((xn, e, 0));
-                    }
-                    if m.is_finite() && best.as_ref().is_none_or(|b| m < b.0) {
-                        best = Some((m, xn, e));
-                    }
-                }
-                Err(err) => last_err = Some(err),
-            }
-            alpha *= 0.5;
-        }
-        match (best, last_err) {
-            (Some((_, xn, e)), _) => Ok((xn, e, LINE_SEARCH_CUTS)),
-            (None, Some(err)) => Err(err),
-            (None, None) => Err(Error::NoConvergence(
-                "non-finite residual at every line-search step".into(),
-            )),
-        }
-    }
-
-    /// Linearised Dirichlet predictor: when prescribed values change, the first update
-    /// solves the tangent system at the committed state with the prescribed increments as
-    /// its constraint rows, so the increment's jump spreads over the body instead of
-    /// straining only the elements next to the moved nodes (such a first iterate can
-    /// carry a plastic body far outside Newton's basin). For a linear problem the
-    /// predictor is the solution.
-    fn dirichlet_predictor(
-        &self,
-        ctx: &IncrementContext<'_>,
-        t_new: f64,
-        x: &mut [f64],
-        linear: &mut FaerLu,
-        times: &mut PhaseTimes,
-    ) -> Result<()> {
-        let jumps: Vec<(usize, f64)> = self
-            .model
-            .dirichlet
-            .iter()
-            .filter(|bc| bc.value.value(t_new) != bc.value.value(self.time))
-            .flat_map(|bc| {
-                let v = bc.value.value(t_new);
-                bc.nodes.iter().map(move |&n| (3 * n + bc.component, v))
-            })
-            .collect();
-        if jumps.is_empty() {
-            return Ok(());
-        }
-        let mut eval = ctx.evaluate(x, times)?;
-        for &(d, v) in &jumps {
-            eval.residual[d] = x[d] - v;
-        }
-        let ts = Instant::now();
-        let dx = self.newton_step(&eval, linear)?;
-        times.factorization_and_solve += ts.elapsed().as_secs_f64();
-        for (xi, d) in x.iter_mut().zip(&dx) {
-            *xi += d;
-        }
-        Ok(())
-    }
-
-    fn frozen_frames(&self, t_new: f64) -> Vec<Vec<Option<FrozenFrame>>> {
-        self.model
-            .contacts
-            .iter()
-            .enumerate()
-            .map(|(c, contact)| {
-                let pose = force_control::pose(&self.model, &self.dofs, c, t_new, &self.x);
-                contact
-                    .candidates
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &node)| {
-                        let xn = self.model.mesh.nodes[node] + self.displacement(node);
-                        let hint = self.contact[c][k].hint;
-                        contact
-                            .tool
-                            .project(&pose, &xn, hint.as_ref())
-                            .map(|p| FrozenFrame {
-                                foot_local: pose.to_local(&p.foot),
-                                normal_local: pose.to_local_vector(&p.normal),
-                            })
-                    })
-                    .collect()
-            })
-            .collect()
-    }
-
     fn commit(
         &mut self,
         t_new: f64,
@@ -1015,6 +550,7 @@ impl Simulation {
     ) -> IncrementReport {
         let mut tool_forces = Vec::new();
         let mut dissipated = vec![0.0; self.model.contacts.len()];
+        let mut normal_work = vec![0.0; self.model.contacts.len()];
         let (mut active, mut slipping) = (0, 0);
         for (c, contact) in self.model.contacts.iter().enumerate() {
             let pose = force_control::pose(&self.model, &self.dofs, c, t_new, &x);
@@ -1027,8 +563,15 @@ impl Simulation {
                     + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
                 // Work of the contact force on the relative motion, by the trapezoidal rule
                 // like every other work term (Psi below follows the paper instead).
+                // Of it, friction dissipates lambda_t . delta_t (exactly 0 for mu = 0); the
+                // rest is the normal force's work on the relative motion, zero for the exact
+                // solution, which the trapezoidal rule picks up where a gap closes within
+                // the increment (and penalty penetration stores).
                 let relative_motion = xn - pose.to_global_point(&s.x_ref_local);
-                dissipated[c] += 0.5 * (s.lambda + res.f_equi).dot(&relative_motion);
+                let interface = 0.5 * (s.lambda + res.f_equi).dot(&relative_motion);
+                let friction = res.tangential_force.dot(&res.slip_increment);
+                dissipated[c] += friction;
+                normal_work[c] += interface - friction;
                 // The converged force on the tool is F_equi (= lambda for the mixed method).
                 s.lambda = res.f_equi;
                 s.status = res.status;
@@ -1070,7 +613,7 @@ impl Simulation {
             }
             tool_forces.push([total.x, total.y, total.z]);
         }
-        let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated);
+        let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated, &normal_work);
         let tool_offsets = (0..self.model.contacts.len())
             .map(|c| force_control::offset(&self.dofs, c, &x))
             .collect();
@@ -1102,66 +645,6 @@ impl Simulation {
             cycling: Vec::new(),
             warnings: Vec::new(),
         }
-    }
-
-    /// Updates the energy balance with one converged increment: trapezoidal rule for the
-    /// work of tools, loads, supports and for the frictional dissipation; the elastic energy
-    /// is a state function.
-    fn account_energy(
-        &mut self,
-        t_new: f64,
-        x: &[f64],
-        eval: &Evaluation,
-        tool_forces: &[[f64; 3]],
-        dissipated: &[f64],
-    ) -> EnergyBalance {
-        let n_u = 3 * self.dofs.n_nodes;
-        let e = &mut self.energy;
-        let last = &self.energy_memory;
-        for d in 0..n_u {
-            let du = x[d] - self.x[d];
-            e.support_work += 0.5 * (last.support_forces[d] + eval.support_forces[d]) * du;
-            e.load_work += 0.5 * (last.external_forces[d] + eval.f_ext[d]) * du;
-        }
-        for c in 0..self.model.contacts.len() {
-            let travel = force_control::pose(&self.model, &self.dofs, c, t_new, x).translation
-                - force_control::pose(&self.model, &self.dofs, c, self.time, &self.x).translation;
-            let force = Vec3::from(tool_forces[c]);
-            // The body pushes the tool with +lambda, the tool the body with -lambda.
-            e.tool_work -= 0.5 * (last.tool_forces[c] + force).dot(&travel);
-            e.frictional_dissipation[c] += dissipated[c];
-        }
-        let element =
-            crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
-        e.elastic_energy = crate::element::total_strain_energy(
-            &self.model.mesh,
-            element,
-            &eval.trial_points,
-            self.model.material.as_ref(),
-        )
-        .unwrap_or(f64::NAN);
-        e.plastic_dissipation = crate::element::total_plastic_dissipation(
-            &self.model.mesh,
-            element,
-            &eval.trial_points,
-        )
-        .unwrap_or(f64::NAN);
-        let input = e.tool_work + e.load_work + e.support_work;
-        let stored: f64 =
-            e.elastic_energy + e.plastic_dissipation + e.frictional_dissipation.iter().sum::<f64>();
-        let scale =
-            (e.tool_work.abs() + e.load_work.abs() + e.support_work.abs()).max(stored.abs());
-        e.relative_error = if scale > 0.0 {
-            (input - stored) / scale
-        } else {
-            0.0
-        };
-        self.energy_memory = EnergyMemory {
-            support_forces: eval.support_forces.clone(),
-            external_forces: eval.f_ext.clone(),
-            tool_forces: tool_forces.iter().map(|f| Vec3::from(*f)).collect(),
-        };
-        e.clone()
     }
 
     /// The committed state: what a checkpoint holds and `rollback` returns to.
@@ -1211,6 +694,9 @@ impl Simulation {
             ));
         }
         settings.stepping.validate(settings.end_time)?;
+        if settings.linear_solver != old.linear_solver {
+            self.linear = Solver::new(settings.linear_solver);
+        }
         let (lo, hi) = (
             settings.stepping.dt_min(settings.end_time),
             settings.stepping.dt_max(settings.end_time),
@@ -1269,39 +755,32 @@ impl Simulation {
     }
 }
 
-/// Energy bookkeeping of a run, cumulative from t = 0.
-#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
-pub struct EnergyBalance {
-    /// Work done on the body by the tools' motion.
-    pub tool_work: f64,
-    /// Work of the applied loads.
-    pub load_work: f64,
-    /// Work of the supports at prescribed (non-zero) displacements.
-    pub support_work: f64,
-    /// Elastic energy stored in the body now.
-    pub elastic_energy: f64,
-    /// Plastic work dissipated in the body so far (trapezoidal per increment, see
-    /// `PointState::plastic_dissipation`).
-    pub plastic_dissipation: f64,
-    /// Frictional dissipation per tool: the work of the contact forces on the slip,
-    /// 1/2 (lambda_n + lambda_{n+1}) . delta per node and increment, the same trapezoidal
-    /// rule as the other work terms, which makes the balance exact for elastic bodies. The
-    /// nodes' frictional work Psi (the friction law's variable) uses the paper's
-    /// lambda_{n+1} . delta_t and differs from it where the force changes within an
-    /// increment (a stick-slip transition, a changing mu).
-    pub frictional_dissipation: Vec<f64>,
-    /// (work in - stored - dissipated) / scale.
-    pub relative_error: f64,
-}
-
-/// Forces at the end of the last increment, for the trapezoidal rule.
-#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
-pub struct EnergyMemory {
-    support_forces: Vec<f64>,
-    external_forces: Vec<f64>,
-    tool_forces: Vec<Vec3>,
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|a| a * a).sum::<f64>().sqrt()
+/// The one warning of a run about contact-status cycling: where it happened first, whether
+/// the result is sound, and what to try.
+fn cycling_warning(
+    model: &Model,
+    cycling: &[CyclingNode],
+    increment: usize,
+    treatment: super::step_control::AntiCycling,
+) -> String {
+    const SHOWN: usize = 5;
+    let nodes: Vec<String> = cycling
+        .iter()
+        .take(SHOWN)
+        .map(|n| format!("{}:{} ({} flips)", model.contacts[n.tool].tool.name, n.node, n.flips))
+        .collect();
+    let more = cycling.len().saturating_sub(SHOWN);
+    format!(
+        "from increment {increment} on, the contact status of some barely touching nodes changes back and forth during Newton's iterations (here {} node(s): {}{}). \
+         Each increment is still accepted only when the unmodified friction law holds to the Newton tolerances, so the results are sound; cycling costs iterations. \
+         If increments take many iterations or are cut back, try smaller increments (increments, or step_control: \"adaptive\"){}. \
+         Not repeated: the count per increment is the column cycling_nodes of history.csv.",
+        cycling.len(),
+        nodes.join(", "),
+        if more > 0 { format!(" and {more} more") } else { String::new() },
+        match treatment {
+            super::step_control::AntiCycling::Off => ", or anti_cycling: \"freeze\"",
+            _ => "",
+        }
+    )
 }

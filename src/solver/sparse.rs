@@ -11,6 +11,11 @@ pub struct SparsePattern {
     pub n: usize,
     pub col_ptr: Vec<usize>,
     pub row_idx: Vec<usize>,
+    /// Optional elimination groups, one id per unknown: unknowns sharing an id are
+    /// eliminated together, in index order, by a factorization without pivoting (a contact
+    /// node's displacements, then its multipliers, whose own pivot may be zero). Pivoting
+    /// factorizations ignore it.
+    pub groups: Option<std::sync::Arc<Vec<usize>>>,
 }
 
 impl SparsePattern {
@@ -33,7 +38,15 @@ impl SparsePattern {
             n,
             col_ptr,
             row_idx,
+            groups: None,
         }
+    }
+
+    /// The same pattern with elimination groups (see [`Self::groups`]).
+    pub fn with_groups(mut self, groups: Vec<usize>) -> Self {
+        debug_assert_eq!(groups.len(), self.n);
+        self.groups = Some(std::sync::Arc::new(groups));
+        self
     }
 
     pub fn nnz(&self) -> usize {
@@ -86,6 +99,18 @@ impl SparseMatrix {
                 }
             }
         }
+    }
+
+    /// Sum of the absolute values of each row (the infinity norm is their largest).
+    pub fn row_abs_sums(&self) -> Vec<f64> {
+        let p = &self.pattern;
+        let mut sums = vec![0.0; p.n];
+        for c in 0..p.n {
+            for k in p.col_ptr[c]..p.col_ptr[c + 1] {
+                sums[p.row_idx[k]] += self.values[k].abs();
+            }
+        }
+        sums
     }
 
     /// y = A x.

@@ -1,0 +1,163 @@
+//! Times the linear solve of a Newton step on a system written by a real run, old (faer's
+//! pivoting LU) against new (LU without pivoting on the symmetric structure), and the
+//! factorization floor: faer's supernodal Cholesky (AMD) of an SPD matrix with the pattern
+//! of A + A^T.
+//!
+//! ```text
+//! TRIBO_DUMP_SYSTEM=/tmp/cup.sys tribo run scripts/square_cup.rhai --quiet \
+//!     --set cells=25 --set travel=2 --set charts=false --out /tmp/cup
+//! cargo run --release --example bench_factorization -- /tmp/cup.sys [REPEATS]
+//! ```
+//! One thread; each figure is the mean of REPEATS (default 5) numeric factorizations and
+//! solves after the symbolic analysis, wall and process CPU seconds.
+use std::sync::Arc;
+use std::time::Instant;
+use tribo::solver::linear::{FaerLu, LinearSolver, SymmetricLu};
+use tribo::solver::sparse::{SparseMatrix, SparsePattern};
+use tribo::solver::system_dump;
+
+fn cpu_seconds() -> f64 {
+    // utime + stime of this process, in clock ticks (100 per second on Linux).
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let fields: Vec<&str> = stat.rsplit(')').next().unwrap_or("").split_whitespace().collect();
+    let tick = |i: usize| fields.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (tick(11) + tick(12)) / 100.0
+}
+
+/// Mean wall and CPU milliseconds of `f` over `repeats` calls, after one untimed call.
+fn time(repeats: usize, mut f: impl FnMut()) -> (f64, f64) {
+    f();
+    let (t0, c0) = (Instant::now(), cpu_seconds());
+    for _ in 0..repeats {
+        f();
+    }
+    let wall = t0.elapsed().as_secs_f64() * 1e3 / repeats as f64;
+    (wall, (cpu_seconds() - c0) * 1e3 / repeats as f64)
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let path = args.next().expect("usage: bench_factorization SYSTEM_FILE [REPEATS]");
+    let repeats: usize = args.next().map_or(5, |s| s.parse().expect("REPEATS"));
+    let (mut a, rhs, border) = system_dump::read(path.as_ref()).unwrap();
+    if std::env::var_os("BENCH_NO_GROUPS").is_some() {
+        let mut p = (*a.pattern).clone();
+        p.groups = None;
+        a.pattern = Arc::new(p);
+    }
+    let only_new = std::env::var_os("BENCH_ONLY_NEW").is_some();
+    let n = a.pattern.n;
+    println!(
+        "system: n = {n}, nnz(A) = {}, border unknowns {:?}, elimination groups: {}",
+        a.pattern.nnz(),
+        border,
+        a.pattern.groups.is_some()
+    );
+    let solve = |solver: &mut dyn LinearSolver| {
+        let mut x = rhs.clone();
+        solver.solve_bordered(&a, &mut x, &border).unwrap();
+        x
+    };
+    let mut lu = FaerLu::default();
+    let t0 = Instant::now();
+    let x_lu = solve(&mut lu);
+    let first_lu = t0.elapsed().as_secs_f64() * 1e3;
+    let (lu_wall, lu_cpu) = time(if only_new { 0 } else { repeats }, || {
+        solve(&mut lu);
+    });
+    let mut sym = SymmetricLu::default();
+    let t0 = Instant::now();
+    let x_sym = solve(&mut sym);
+    let first_sym = t0.elapsed().as_secs_f64() * 1e3;
+    let (sym_wall, sym_cpu) = time(repeats, || {
+        solve(&mut sym);
+    });
+    let scale = x_lu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = x_lu.iter().zip(&x_sym).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+    println!(
+        "faer LU (partial pivoting, COLAMD): first call {first_lu:.1} ms, then {lu_wall:.1} ms wall / {lu_cpu:.1} ms CPU per factorization + solve"
+    );
+    println!(
+        "symmetric LU (no pivoting, AMD on A + A^T): first call {first_sym:.1} ms, then {sym_wall:.1} ms wall / {sym_cpu:.1} ms CPU; L+U {} entries; fallbacks {}",
+        sym.factor_len().map_or("?".into(), |l| l.to_string()),
+        sym.fallback_count
+    );
+    println!(
+        "solutions differ by {:.1e} of the largest entry; speed-up {:.2}x",
+        diff / scale,
+        lu_wall / sym_wall
+    );
+    if only_new {
+        return;
+    }
+    let (floor_wall, floor_cpu, l_len) = cholesky_floor(&a.pattern, repeats);
+    println!(
+        "floor, faer Cholesky (AMD, supernodal) of an SPD matrix on A + A^T: {floor_wall:.1} ms wall / {floor_cpu:.1} ms CPU, L {l_len} entries; new / floor {:.2}, old / floor {:.2}",
+        sym_wall / floor_wall,
+        lu_wall / floor_wall
+    );
+}
+
+/// Mean time of faer's numeric LL^T (after its symbolic analysis) of the SPD matrix with
+/// off-diagonal entries -1 on the pattern of A + A^T and its degree + 1 on the diagonal.
+fn cholesky_floor(p: &SparsePattern, repeats: usize) -> (f64, f64, usize) {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::cholesky::{
+        factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+    };
+    use faer::linalg::cholesky::llt::factor::LltRegularization;
+    use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+    use faer::{Par, Side};
+    let n = p.n;
+    let lower = SparsePattern::from_entries(
+        n,
+        (0..n)
+            .flat_map(|c| {
+                p.row_idx[p.col_ptr[c]..p.col_ptr[c + 1]]
+                    .iter()
+                    .map(move |&r| (r.max(c), r.min(c)))
+            })
+            .chain((0..n).map(|i| (i, i))),
+    );
+    let mut m = SparseMatrix::zeros(Arc::new(lower.clone()));
+    let mut degree = vec![0.0; n];
+    for c in 0..n {
+        for k in lower.col_ptr[c]..lower.col_ptr[c + 1] {
+            let r = lower.row_idx[k];
+            if r != c {
+                m.values[k] = -1.0;
+                degree[r] += 1.0;
+                degree[c] += 1.0;
+            }
+        }
+    }
+    for (c, d) in degree.iter().enumerate() {
+        let k = lower.position(c, c).unwrap();
+        m.values[k] = d + 1.0;
+    }
+    let sym = SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
+    let symbolic = factorize_symbolic_cholesky(
+        sym,
+        Side::Lower,
+        SymmetricOrdering::Amd,
+        CholeskySymbolicParams::default(),
+    )
+    .unwrap();
+    let mut l_values = vec![0.0; symbolic.len_val()];
+    let mut buffer =
+        MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
+    let (wall, cpu) = time(repeats, || {
+        symbolic
+            .factorize_numeric_llt(
+                &mut l_values,
+                SparseColMatRef::new(sym, &m.values),
+                Side::Lower,
+                LltRegularization::default(),
+                Par::Seq,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .unwrap();
+    });
+    (wall, cpu, symbolic.len_val())
+}

@@ -1,0 +1,390 @@
+//! `tribo bench`: the speed table of a few standard cases, optionally side by side with
+//! another tribo binary (`--baseline`), so that every speed claim can be reproduced.
+//!
+//! Each case is one whole run of a committed script (embedded in the binary, written to a
+//! temporary folder) as a child process, `tribo run SCRIPT --set ... --quiet --out DIR`,
+//! of this binary and of the baseline in turn (this, baseline, per case, so that drift of a
+//! shared machine hits both alike). From the run's `summary.json` it reads the counts and
+//! the per-phase seconds (`phase_times_s`, whatever phases the binary records); CPU seconds
+//! are the child's user + system time (Linux: the parent's `cutime + cstime` in
+//! `/proc/self/stat` before and after waiting for it, 1/100 s resolution), wall seconds the
+//! parent's clock around the child. The numbers are reported, never judged.
+
+use crate::{Error, Result};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+const SQUARE_CUP: &str = include_str!("../../scripts/square_cup.rhai");
+const CYLINDER_DRAG: &str = include_str!("../../scripts/cylinder_drag.rhai");
+
+/// The cases `--case` accepts.
+pub const CASES: [&str; 3] = ["cup", "cup-benchmark", "drag"];
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// Case names from [`CASES`] (or "all").
+    pub cases: Vec<String>,
+    /// Cells per blank edge (cup, default 25) or along the block (drag, default 32).
+    pub cells: Option<usize>,
+    /// Cells through the sheet (cup only; default 1).
+    pub layers: Option<usize>,
+    /// Punch travel in mm (cup only; default the variant's own, 30 or 40).
+    pub travel: Option<f64>,
+    /// Another tribo binary run on the same cases.
+    pub baseline: Option<PathBuf>,
+    /// Where to write the table as JSON.
+    pub json: Option<PathBuf>,
+    /// Folder for scripts and run outputs (default: a folder under the system's temp).
+    pub work_dir: Option<PathBuf>,
+}
+
+/// One case, checked and ready to run.
+#[derive(Clone, Debug, Serialize)]
+pub struct Case {
+    pub name: String,
+    /// The `--set` overrides passed to the script.
+    pub sets: Vec<String>,
+    #[serde(skip)]
+    script: &'static str,
+}
+
+/// One run of one binary on one case.
+#[derive(Clone, Debug, Serialize)]
+pub struct Measurement {
+    pub binary: String,
+    /// The run's output folder (its summary.json is where every count comes from).
+    pub out_dir: PathBuf,
+    pub nodes: usize,
+    /// Displacement unknowns, 3 per node.
+    pub displacement_unknowns: usize,
+    pub increments: usize,
+    pub newton_iterations: usize,
+    pub line_search_cuts: usize,
+    /// Trial states evaluated per Newton iteration, (iterations + cuts) / iterations: the
+    /// full step and each cut (predictors and re-evaluations not counted).
+    pub trials_per_iteration: f64,
+    /// Seconds per phase as the run recorded them.
+    pub phase_times_s: BTreeMap<String, f64>,
+    pub cpu_s: Option<f64>,
+    pub wall_s: f64,
+    /// cpu_s (or wall_s without it) per Newton iteration, in ms.
+    pub ms_per_iteration: f64,
+}
+
+/// A case with this binary's run and, with `--baseline`, the baseline's.
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseResult {
+    pub case: Case,
+    pub this: Measurement,
+    pub baseline: Option<Measurement>,
+}
+
+/// Checks the options and expands the case list; errors name the offending value.
+pub fn cases(opts: &BenchOptions) -> Result<Vec<Case>> {
+    if opts.cases.is_empty() {
+        return Err(Error::input("--case", "(none)", "give at least one case"));
+    }
+    if let Some(c) = opts.cells.filter(|&c| c == 0 || c > 400) {
+        return Err(Error::input("--cells", c, "must be in 1..=400"));
+    }
+    if let Some(l) = opts.layers.filter(|&l| l == 0 || l > 16) {
+        return Err(Error::input("--layers", l, "must be in 1..=16"));
+    }
+    if let Some(t) = opts.travel.filter(|t| !(*t > 0.0 && *t <= 60.0)) {
+        return Err(Error::input("--travel", t, "must be in (0, 60] mm"));
+    }
+    if let Some(b) = &opts.baseline {
+        if !b.is_file() {
+            return Err(Error::input(
+                "--baseline",
+                b.display(),
+                "is not a file (give the path of another tribo binary)",
+            ));
+        }
+    }
+    let mut names = Vec::new();
+    for name in &opts.cases {
+        match name.as_str() {
+            "all" => names.extend(CASES.iter().map(|s| s.to_string())),
+            n if CASES.contains(&n) => names.push(n.to_string()),
+            other => {
+                return Err(Error::input(
+                    "--case",
+                    format!("\"{other}\""),
+                    &format!("must be one of {} or all", CASES.join(", ")),
+                ))
+            }
+        }
+    }
+    Ok(names
+        .into_iter()
+        .map(|name| {
+            let (script, sets) = if name == "drag" {
+                let cells = opts.cells.unwrap_or(32).max(4);
+                (CYLINDER_DRAG, vec![format!("cells={cells}")])
+            } else {
+                let variant = if name == "cup" { "paper" } else { "benchmark" };
+                let mut sets = vec![
+                    format!("variant=\"{variant}\""),
+                    format!("cells={}", opts.cells.unwrap_or(25)),
+                    format!("layers={}", opts.layers.unwrap_or(1)),
+                    "charts=false".to_string(),
+                ];
+                if let Some(t) = opts.travel {
+                    sets.push(format!("travel={t:?}"));
+                }
+                (SQUARE_CUP, sets)
+            };
+            Case { name, sets, script }
+        })
+        .collect())
+}
+
+/// Runs every case with this binary (`this`) and the baseline, prints the table as it
+/// goes, writes the JSON if asked, and returns the results.
+pub fn run(opts: &BenchOptions, this: &Path) -> Result<Vec<CaseResult>> {
+    let cases = cases(opts)?;
+    let work = opts.work_dir.clone().unwrap_or_else(|| {
+        std::env::temp_dir().join(format!("tribo-bench-{}", std::process::id()))
+    });
+    std::fs::create_dir_all(&work).map_err(|e| Error::io(&work, e))?;
+    let mut results = Vec::new();
+    for case in cases {
+        let script = work.join(format!("{}.rhai", case.name));
+        std::fs::write(&script, case.script).map_err(|e| Error::io(&script, e))?;
+        let this_run = measure(
+            this,
+            &script,
+            &case,
+            &work.join(format!("{}-this", case.name)),
+        )?;
+        let base_run = match &opts.baseline {
+            Some(b) => Some(measure(
+                b,
+                &script,
+                &case,
+                &work.join(format!("{}-baseline", case.name)),
+            )?),
+            None => None,
+        };
+        let result = CaseResult {
+            case,
+            this: this_run,
+            baseline: base_run,
+        };
+        print!("{}", table(&result));
+        results.push(result);
+    }
+    if let Some(path) = &opts.json {
+        let text = serde_json::to_string_pretty(&results)
+            .map_err(|e| Error::Input(format!("bench JSON: {e}")))?;
+        std::fs::write(path, text).map_err(|e| Error::io(path, e))?;
+    }
+    Ok(results)
+}
+
+/// The children's CPU seconds so far (user + system of waited-for children), Linux only.
+fn children_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) start at field 3.
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    // cutime and cstime are fields 16 and 17 (1-based), i.e. 13 and 14 after ')'.
+    let ticks = fields.get(13)?.parse::<f64>().ok()? + fields.get(14)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+fn measure(binary: &Path, script: &Path, case: &Case, out: &Path) -> Result<Measurement> {
+    let cpu0 = children_cpu_seconds();
+    let start = Instant::now();
+    let output = std::process::Command::new(binary)
+        .arg("run")
+        .arg(script)
+        .arg("--quiet")
+        .arg("--out")
+        .arg(out)
+        .args(case.sets.iter().flat_map(|s| ["--set", s.as_str()]))
+        .output()
+        .map_err(|e| Error::Input(format!("bench: cannot start {}: {e}", binary.display())))?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let cpu_s = match (cpu0, children_cpu_seconds()) {
+        (Some(a), Some(b)) => Some(b - a),
+        _ => None,
+    };
+    if !output.status.success() {
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let tail: Vec<&str> = stderr.lines().rev().take(5).collect();
+        return Err(Error::NoConvergence(format!(
+            "bench case {} with {}: the run failed ({}): {}",
+            case.name,
+            binary.display(),
+            output.status,
+            tail.into_iter().rev().collect::<Vec<_>>().join(" | ")
+        )));
+    }
+    let summary_path = out.join("summary.json");
+    let text = std::fs::read_to_string(&summary_path).map_err(|e| Error::io(&summary_path, e))?;
+    let summary: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::Input(format!("{}: {e}", summary_path.display())))?;
+    let count = |key: &str| -> Result<usize> {
+        summary[key]
+            .as_u64()
+            .map(|v| v as usize)
+            .ok_or_else(|| Error::Input(format!("{}: no count \"{key}\"", summary_path.display())))
+    };
+    let nodes = count("nodes")?;
+    let newton_iterations = count("newton_iterations")?;
+    let line_search_cuts = count("line_search_cuts")?;
+    let phase_times_s = summary["phase_times_s"]
+        .as_object()
+        .map(|m| {
+            m.iter()
+                .filter_map(|(k, v)| v.as_f64().map(|v| (k.clone(), v)))
+                .collect()
+        })
+        .unwrap_or_default();
+    let iterations = newton_iterations.max(1) as f64;
+    Ok(Measurement {
+        binary: binary.display().to_string(),
+        out_dir: out.to_path_buf(),
+        nodes,
+        displacement_unknowns: 3 * nodes,
+        increments: count("increments")?,
+        newton_iterations,
+        line_search_cuts,
+        trials_per_iteration: (newton_iterations + line_search_cuts) as f64 / iterations,
+        phase_times_s,
+        cpu_s,
+        wall_s,
+        ms_per_iteration: 1e3 * cpu_s.unwrap_or(wall_s) / iterations,
+    })
+}
+
+/// The rows of one case: this binary, the baseline, and baseline / this (a speed-up above 1
+/// where this binary is faster).
+fn table(result: &CaseResult) -> String {
+    let mut phases: Vec<String> = result.this.phase_times_s.keys().cloned().collect();
+    if let Some(b) = &result.baseline {
+        for k in b.phase_times_s.keys() {
+            if !phases.contains(k) {
+                phases.push(k.clone());
+            }
+        }
+    }
+    let mut s = format!(
+        "\ncase {} ({})\n{:<9} {:>7} {:>5} {:>6} {:>5} {:>8}",
+        result.case.name,
+        result.case.sets.join(" "),
+        "binary",
+        "u dofs",
+        "incr",
+        "iters",
+        "cuts",
+        "trial/it"
+    );
+    for p in &phases {
+        s += &format!(" {:>12}", format!("{p} s"));
+    }
+    s += &format!(" {:>8} {:>8} {:>9}\n", "cpu s", "wall s", "ms/iter");
+    let row = |label: &str, m: &Measurement| {
+        let mut r = format!(
+            "{label:<9} {:>7} {:>5} {:>6} {:>5} {:>8.2}",
+            m.displacement_unknowns,
+            m.increments,
+            m.newton_iterations,
+            m.line_search_cuts,
+            m.trials_per_iteration
+        );
+        for p in &phases {
+            match m.phase_times_s.get(p) {
+                Some(v) => r += &format!(" {v:>12.3}"),
+                None => r += &format!(" {:>12}", "-"),
+            }
+        }
+        let cpu = m.cpu_s.map_or("-".to_string(), |c| format!("{c:.2}"));
+        r += &format!(" {cpu:>8} {:>8.2} {:>9.2}\n", m.wall_s, m.ms_per_iteration);
+        r
+    };
+    s += &row("this", &result.this);
+    if let Some(b) = &result.baseline {
+        s += &row("baseline", b);
+        let ratio = |a: f64, b: f64| {
+            if a > 0.0 {
+                format!("{:.2}", b / a)
+            } else {
+                "-".to_string()
+            }
+        };
+        let t = &result.this;
+        let mut r = format!(
+            "{:<9} {:>7} {:>5} {:>6} {:>5} {:>8}",
+            "base/this", "", "", "", "", ""
+        );
+        for p in &phases {
+            match (t.phase_times_s.get(p), b.phase_times_s.get(p)) {
+                (Some(x), Some(y)) => r += &format!(" {:>12}", ratio(*x, *y)),
+                _ => r += &format!(" {:>12}", "-"),
+            }
+        }
+        let cpu = match (t.cpu_s, b.cpu_s) {
+            (Some(x), Some(y)) => ratio(x, y),
+            _ => "-".into(),
+        };
+        r += &format!(
+            " {cpu:>8} {:>8} {:>9}\n",
+            ratio(t.wall_s, b.wall_s),
+            ratio(t.ms_per_iteration, b.ms_per_iteration)
+        );
+        s += &r;
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn opts(cases: &[&str]) -> BenchOptions {
+        BenchOptions {
+            cases: cases.iter().map(|s| s.to_string()).collect(),
+            cells: None,
+            layers: None,
+            travel: None,
+            baseline: None,
+            json: None,
+            work_dir: None,
+        }
+    }
+
+    /// Case names and sizes are checked before anything runs; "all" expands; the sizes
+    /// reach the script's overrides.
+    #[test]
+    fn options_are_checked_and_expanded() {
+        let err = cases(&opts(&["cup", "kettle"])).unwrap_err().to_string();
+        assert!(err.contains("--case") && err.contains("kettle"), "{err}");
+        assert!(cases(&opts(&[])).is_err());
+        let mut o = opts(&["all"]);
+        assert_eq!(cases(&o).unwrap().len(), 3);
+        o.cells = Some(0);
+        assert!(cases(&o).unwrap_err().to_string().contains("--cells"));
+        o.cells = Some(10);
+        o.travel = Some(-1.0);
+        assert!(cases(&o).unwrap_err().to_string().contains("--travel"));
+        o.travel = Some(2.5);
+        o.layers = Some(2);
+        let c = cases(&o).unwrap();
+        assert!(c[1].sets.contains(&"variant=\"benchmark\"".to_string()));
+        assert!(c[0].sets.contains(&"travel=2.5".to_string()));
+        assert!(c[0].sets.contains(&"layers=2".to_string()));
+        assert_eq!(c[2].sets, vec!["cells=10".to_string()]);
+        o.baseline = Some(PathBuf::from("/no/such/tribo"));
+        let err = cases(&o).unwrap_err().to_string();
+        assert!(
+            err.contains("--baseline") && err.contains("/no/such/tribo"),
+            "{err}"
+        );
+    }
+}

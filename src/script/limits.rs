@@ -1,0 +1,173 @@
+//! Resource bounds of a run, each with a default and a command-line override, each stopping
+//! with a message that names the limit, the value reached and the option that raises it.
+//!
+//! * **Memory**: a mesh is refused before it is allocated when its estimated need is over the
+//!   limit ([`Limits::check_mesh`]); while the script itself runs, the process's peak
+//!   resident memory (`getrusage`) is checked every [`CHECK_EVERY`] operations.
+//! * **Script wall time**: time spent in the script's own code, not in the simulation
+//!   (`sim.run()`/`sim.step()` are timed apart and subtracted), checked with the memory.
+//! * **Increments** and **output size**: see [`Limits::max_increments`] and
+//!   [`crate::paths::set_output_limit`].
+
+use std::cell::Cell;
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+
+/// The script-progress callback looks at the clock and the memory every this many operations
+/// (a `getrusage` call, about 0.3 us, so under 10 ns per operation).
+pub const CHECK_EVERY: u64 = 64;
+
+/// Measured peak resident memory per mesh node of a run (assembled tangent, its
+/// factorisation, contact data): 63 KB/node for the thin square-cup blank, 80-84 KB/node for
+/// the thick cylinder-drag block (scripts/cylinder_drag.rhai with cells = 96 and 128, peak RSS
+/// 385 and 712 MB for 4 850 and 8 514 nodes); 100 KB leaves a margin.
+pub const BYTES_PER_NODE: u64 = 100_000;
+/// Resident memory of the process before any mesh.
+pub const BASE_BYTES: u64 = 20 << 20;
+
+/// The bounds of one run.
+#[derive(Clone, Debug)]
+pub struct Limits {
+    /// Memory the process may use, in bytes (default: half the machine's memory).
+    pub max_memory: u64,
+    /// Wall time of the script's own code (the simulation excluded).
+    pub max_script_time: Duration,
+    /// Increments one simulation may take (settings `increments` above it are refused; an
+    /// adaptive run stops there).
+    pub max_increments: usize,
+    /// Bytes the run may write into its output folder.
+    pub max_output: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_memory: machine_memory().map_or(8 << 30, |m| m / 2),
+            max_script_time: Duration::from_secs(600),
+            max_increments: 100_000,
+            max_output: 20 << 30,
+        }
+    }
+}
+
+/// Total memory of the machine (`MemTotal` of /proc/meminfo), in bytes.
+pub fn machine_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Peak resident memory of this process so far, in bytes (`getrusage`, `ru_maxrss`): it
+/// only grows, so it says whether the limit was ever passed.
+pub fn peak_memory() -> Option<u64> {
+    // SAFETY: getrusage writes into the zeroed struct it is given and has no other effect.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let rc = unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) };
+    (rc == 0).then(|| usage.ru_maxrss.max(0) as u64 * 1024)
+}
+
+fn mib(bytes: u64) -> String {
+    format!("{:.0} MiB", bytes as f64 / (1u64 << 20) as f64)
+}
+
+impl Limits {
+    /// Refuses a mesh of `nodes` nodes whose estimated memory is over the limit, before it
+    /// is built.
+    pub fn check_mesh(&self, nodes: u64) -> Result<(), String> {
+        let need = nodes.saturating_mul(BYTES_PER_NODE).saturating_add(BASE_BYTES);
+        if need > self.max_memory {
+            return Err(format!(
+                "a mesh of {nodes} nodes needs about {} (estimated at {} KB per node), over the \
+                 memory limit of {}{} (raise it with --max-memory-mb)",
+                mib(need),
+                BYTES_PER_NODE / 1000,
+                mib(self.max_memory),
+                machine_memory()
+                    .map(|m| format!("; this machine has {}", mib(m)))
+                    .unwrap_or_default()
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Time spent in the script's own code: wall time since the start minus time spent
+/// simulating.
+#[derive(Debug)]
+pub struct ScriptClock {
+    start: Instant,
+    excluded: Cell<Duration>,
+}
+
+impl Default for ScriptClock {
+    fn default() -> Self {
+        ScriptClock {
+            start: Instant::now(),
+            excluded: Cell::new(Duration::ZERO),
+        }
+    }
+}
+
+impl ScriptClock {
+    /// Runs `f` (a simulation call) without counting its time as script time.
+    pub fn exclude<T>(&self, f: impl FnOnce() -> T) -> T {
+        let t0 = Instant::now();
+        let r = f();
+        self.excluded.set(self.excluded.get() + t0.elapsed());
+        r
+    }
+
+    pub fn script_time(&self) -> Duration {
+        self.start.elapsed().saturating_sub(self.excluded.get())
+    }
+}
+
+/// The progress callback of the engine: `Some(message)` stops the script (Rhai reports it as
+/// a termination carrying the message).
+pub fn progress_check(limits: &Limits, clock: &Rc<ScriptClock>, ops: u64) -> Option<String> {
+    if ops % CHECK_EVERY != 0 {
+        return None;
+    }
+    let t = clock.script_time();
+    if t > limits.max_script_time {
+        return Some(format!(
+            "the script ran for {:.1} s of its own time (the simulation excluded), over the \
+             limit of {} s (raise it with --max-script-seconds)",
+            t.as_secs_f64(),
+            limits.max_script_time.as_secs()
+        ));
+    }
+    match peak_memory() {
+        Some(rss) if rss > limits.max_memory => Some(format!(
+            "the run uses {} of memory, over the limit of {} (raise it with --max-memory-mb)",
+            mib(rss),
+            mib(limits.max_memory)
+        )),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mesh_estimate_refuses_and_names_the_figures() {
+        let limits = Limits {
+            max_memory: 1 << 30,
+            ..Limits::default()
+        };
+        assert!(limits.check_mesh(1000).is_ok());
+        let e = limits.check_mesh(8_000_000).unwrap_err();
+        assert!(e.contains("8000000 nodes") && e.contains("1024 MiB"), "{e}");
+        assert!(limits.check_mesh(u64::MAX).is_err());
+    }
+
+    #[test]
+    fn proc_figures_are_read() {
+        assert!(machine_memory().unwrap() > 1 << 20);
+        let rss = peak_memory().unwrap();
+        assert!(rss > 1 << 16 && rss < machine_memory().unwrap());
+    }
+}

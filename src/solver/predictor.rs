@@ -1,0 +1,65 @@
+//! First iterates of an increment's Newton solve: the extrapolating predictor (the last
+//! increment's motion continued) and the linearised Dirichlet predictor (prescribed jumps
+//! spread over the body by one tangent solve).
+
+use super::assembly::{IncrementContext, PhaseTimes};
+use super::linear::LinearSolver;
+use super::simulation::Simulation;
+use crate::Result;
+use std::time::Instant;
+
+impl Simulation {
+    /// The last increment's displacement change, scaled to this step, added to `x`: in
+    /// forming the sheet keeps moving the way it moved, so the first iterate starts near the
+    /// right contact statuses (from the committed state, Newton has to rediscover the whole
+    /// active set, tens of iterations on a drawn sheet). O(dofs).
+    pub(super) fn extrapolate(&self, t_new: f64, x: &mut [f64]) {
+        if let Some((dt_last, dx)) = &self.last_step {
+            let ratio = (t_new - self.time) / dt_last;
+            for (xi, d) in x.iter_mut().zip(dx) {
+                *xi += ratio * d;
+            }
+        }
+    }
+
+    /// Linearised Dirichlet predictor: when prescribed values change, the first update
+    /// solves the tangent system at the committed state with the prescribed increments as
+    /// its constraint rows, so the increment's jump spreads over the body instead of
+    /// straining only the elements next to the moved nodes (such a first iterate can
+    /// carry a plastic body far outside Newton's basin). For a linear problem the
+    /// predictor is the solution.
+    pub(super) fn dirichlet_predictor(
+        &self,
+        ctx: &IncrementContext<'_>,
+        t_new: f64,
+        x: &mut [f64],
+        linear: &mut dyn LinearSolver,
+        times: &mut PhaseTimes,
+    ) -> Result<()> {
+        let jumps: Vec<(usize, f64)> = self
+            .model
+            .dirichlet
+            .iter()
+            .filter(|bc| bc.value.value(t_new) != bc.value.value(self.time))
+            .flat_map(|bc| {
+                let v = bc.value.value(t_new);
+                bc.nodes.iter().map(move |&n| (3 * n + bc.component, v))
+            })
+            .collect();
+        if jumps.is_empty() {
+            return Ok(());
+        }
+        let mut eval = ctx.evaluate(x, times)?;
+        for &(d, v) in &jumps {
+            eval.residual[d] = x[d] - v;
+        }
+        let ts = Instant::now();
+        let dx = self.newton_step(&eval, linear)?;
+        times.factorization_and_solve += ts.elapsed().as_secs_f64();
+        for (xi, d) in x.iter_mut().zip(&dx) {
+            *xi += d;
+        }
+        Ok(())
+    }
+
+}

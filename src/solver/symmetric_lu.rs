@@ -1,0 +1,711 @@
+//! Sparse LU without pivoting on the symmetric structure of `A + A^T`.
+//!
+//! The condensed contact system has a structurally symmetric pattern (a contact node's
+//! condensed rows have K's row pattern) and safe diagonal pivots (gap rows: K's diagonal;
+//! stick rows: r times about the identity; slip rows a mix), but it is numerically far from
+//! symmetric. A partial-pivoting LU (faer's, ordered by COLAMD on `A^T A`) pays for the
+//! freedom to pivot with a much larger fill. Here instead:
+//!
+//! - symbolic (once per pattern): AMD on `A + A^T`, and faer's supernodal symbolic Cholesky
+//!   of the permuted `A + A^T`; `L` and `U^T` both take the structure of that Cholesky
+//!   factor. A supernode `s` (columns `f..f+k`, rows `R` below its diagonal block) stores a
+//!   dense panel `(k + |R|) x k` holding the diagonal block `L_ss \ U_ss` and `L_Rs`, and a
+//!   dense panel `|R| x k` holding `U_sR^T`;
+//! - numeric (every call), left-looking by supernodes: gather `A`'s entries into the panels
+//!   through a precomputed slot per entry; subtract the updates of every descendant `d`
+//!   whose rows meet `s`'s columns (`L_{R_d,d} U_{d,s}` and `U^T` likewise, two dense
+//!   products); factorize the diagonal block without pivoting (recursive, dense kernels of
+//!   faer); `L_Rs = A_Rs U_ss^{-1}` and `U_sR = L_ss^{-1} A_sR` by triangular solves.
+//!
+//! Cost: the flops of a Cholesky factorization of the same pattern times two (both triangles),
+//! memory `nnz(L) + nnz(U) = 2 nnz(L_chol) - n`.
+//!
+//! Without pivoting, a tiny pivot would spoil the factors: every diagonal pivot is checked
+//! against the largest entry of its column of `L` and row of `U` before elimination
+//! (`|u_jj| > 1e-10 max`), and the caller checks the backward error of the solution (see
+//! [`super::linear::SymmetricLu`]), falling back to a pivoting LU when either fails.
+
+use super::sparse::SparsePattern;
+use crate::{Error, Result};
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_unit_lower_triangular_in_place,
+    solve_upper_triangular_in_place,
+};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering,
+};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::perm::PermRef;
+use faer::sparse::linalg::{amd, SupernodalThreshold};
+use faer::sparse::SymbolicSparseColMatRef;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::{Accum, MatMut, MatRef, Par, Side};
+use std::sync::Arc;
+
+/// A pivot is refused when `|pivot| <= PIVOT_TOLERANCE * (largest entry of its column of L
+/// and row of U)` (or is not finite).
+pub const PIVOT_TOLERANCE: f64 = 1e-10;
+
+/// One descendant update of a supernode: supernode `d`'s rows `p1..p2` (positions in its row
+/// list) fall into the updated supernode's columns.
+#[derive(Clone, Copy, Debug)]
+struct Update {
+    d: usize,
+    p1: usize,
+    p2: usize,
+}
+
+/// The symbolic analysis of a pattern: ordering, supernodes, panel layout and the slot of
+/// every entry of `A`.
+#[derive(Debug)]
+pub struct SymbolicSymmetricLu {
+    pattern: Arc<SparsePattern>,
+    n: usize,
+    /// New index -> original index.
+    perm: Vec<usize>,
+    /// First column of each supernode (and `n` at the end).
+    begin: Vec<usize>,
+    /// Below-diagonal rows of supernode s: `rows[row_ptr[s]..row_ptr[s + 1]]`, sorted.
+    row_ptr: Vec<usize>,
+    rows: Vec<usize>,
+    /// Offset of supernode s's panels in the value array (L panel, then U^T panel).
+    offset: Vec<usize>,
+    /// Descendant updates of supernode s: `updates[update_ptr[s]..update_ptr[s + 1]]`.
+    update_ptr: Vec<usize>,
+    updates: Vec<Update>,
+    /// Value index of every entry of `A` (in `A`'s storage order).
+    slot: Vec<usize>,
+    len: usize,
+}
+
+impl SymbolicSymmetricLu {
+    /// AMD ordering and supernodal structure of `A + A^T`. O(nnz(L)) time and memory.
+    pub fn new(pattern: &Arc<SparsePattern>) -> Result<Self> {
+        let n = pattern.n;
+        // Lower triangle of A + A^T, diagonal included.
+        let lower = SparsePattern::from_entries(
+            n,
+            (0..n)
+                .flat_map(|c| {
+                    pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]]
+                        .iter()
+                        .map(move |&r| (r.max(c), r.min(c)))
+                })
+                .chain((0..n).map(|i| (i, i))),
+        );
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let grouped = match &pattern.groups {
+            Some(groups) => Some(grouped_order(&lower, groups)?),
+            None => None,
+        };
+        let ordering = match &grouped {
+            Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
+            None => SymmetricOrdering::Amd,
+        };
+        let symbolic = factorize_symbolic_cholesky(sym, Side::Lower, ordering, params)
+            .map_err(|e| Error::LinearSolver(format!("symbolic analysis failed: {e:?}")))?;
+        let perm: Vec<usize> = match symbolic.perm() {
+            Some(p) => p.arrays().0.to_vec(),
+            None => (0..n).collect(),
+        };
+        // Supernodes (first column) and their below-diagonal rows. faer may still choose a
+        // simplicial structure for a tiny or very sparse matrix: then every column is a
+        // supernode of its own.
+        let mut begin = Vec::new();
+        let mut row_ptr = vec![0];
+        let mut rows = Vec::new();
+        match symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => {
+                for s in 0..sn.n_supernodes() {
+                    begin.push(sn.supernode_begin()[s]);
+                    let mut r: Vec<usize> = sn.supernode(s).pattern().to_vec();
+                    r.sort_unstable();
+                    rows.extend_from_slice(&r);
+                    row_ptr.push(rows.len());
+                }
+            }
+            SymbolicCholeskyRaw::Simplicial(sc) => {
+                for j in 0..n {
+                    begin.push(j);
+                    let mut r: Vec<usize> = sc.row_idx()[sc.col_ptr()[j]..sc.col_ptr()[j + 1]]
+                        .iter()
+                        .copied()
+                        .filter(|&i| i > j)
+                        .collect();
+                    r.sort_unstable();
+                    rows.extend_from_slice(&r);
+                    row_ptr.push(rows.len());
+                }
+            }
+        }
+        let ns = begin.len();
+        begin.push(n);
+        let mut col_super = vec![0; n];
+        let mut offset = Vec::with_capacity(ns + 1);
+        let mut len = 0;
+        for s in 0..ns {
+            col_super[begin[s]..begin[s + 1]].fill(s);
+            offset.push(len);
+            let (k, r) = (begin[s + 1] - begin[s], row_ptr[s + 1] - row_ptr[s]);
+            len += (k + r) * k + r * k;
+        }
+        offset.push(len);
+        let mut lists: Vec<Vec<Update>> = vec![Vec::new(); ns];
+        for d in 0..ns {
+            let rd = &rows[row_ptr[d]..row_ptr[d + 1]];
+            let mut p1 = 0;
+            while p1 < rd.len() {
+                let s = col_super[rd[p1]];
+                let mut p2 = p1;
+                while p2 < rd.len() && rd[p2] < begin[s + 1] {
+                    p2 += 1;
+                }
+                lists[s].push(Update { d, p1, p2 });
+                p1 = p2;
+            }
+        }
+        let mut update_ptr = vec![0];
+        let mut updates = Vec::new();
+        for list in lists {
+            updates.extend(list);
+            update_ptr.push(updates.len());
+        }
+        let mut inverse = vec![0; n];
+        for (new, &old) in perm.iter().enumerate() {
+            inverse[old] = new;
+        }
+        let mut analysis = SymbolicSymmetricLu {
+            pattern: pattern.clone(),
+            n,
+            perm,
+            begin,
+            row_ptr,
+            rows,
+            offset,
+            update_ptr,
+            updates,
+            slot: Vec::with_capacity(pattern.nnz()),
+            len,
+        };
+        let mut slot = Vec::with_capacity(pattern.nnz());
+        for c in 0..n {
+            for &r in &pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]] {
+                let (pi, pj) = (inverse[r], inverse[c]);
+                let s = col_super[pi.min(pj)];
+                slot.push(analysis.slot_of(s, pi, pj).ok_or_else(|| {
+                    Error::LinearSolver(format!(
+                        "entry ({r}, {c}) outside the symbolic factor (internal error)"
+                    ))
+                })?);
+            }
+        }
+        analysis.slot = slot;
+        Ok(analysis)
+    }
+
+    /// Value index of permuted entry (i, j) in supernode s, which owns column min(i, j).
+    fn slot_of(&self, s: usize, i: usize, j: usize) -> Option<usize> {
+        let (f, l) = (self.begin[s], self.begin[s + 1]);
+        let k = l - f;
+        let r = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+        let m = k + r.len();
+        let local = |g: usize| {
+            if (f..l).contains(&g) {
+                Some(g - f)
+            } else {
+                r.binary_search(&g).ok().map(|p| k + p)
+            }
+        };
+        if i >= j || i >= f && j < l {
+            // Lower part, or anywhere in the diagonal block: the L panel.
+            Some(self.offset[s] + local(i)? + (j - f) * m)
+        } else {
+            // Upper part outside the diagonal block: U^T panel, row of j, column i.
+            let p = local(j)? - k;
+            Some(self.offset[s] + m * k + p + (i - f) * r.len())
+        }
+    }
+
+    pub fn pattern(&self) -> &Arc<SparsePattern> {
+        &self.pattern
+    }
+
+    /// Stored entries of L and U together (dense panels, explicit zeros included).
+    pub fn factor_len(&self) -> usize {
+        self.len
+    }
+
+    fn panels(&self, s: usize) -> (usize, usize, usize, &[usize]) {
+        let (f, l) = (self.begin[s], self.begin[s + 1]);
+        let r = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+        (f, l - f, r.len(), r)
+    }
+}
+
+/// AMD on the graph of the groups (a vertex per group, an edge where any two members are
+/// coupled), each group expanded in index order: `(new -> old, old -> new)`. Same cost as
+/// AMD on the unknowns, on a graph smaller by the group size.
+fn grouped_order(lower: &SparsePattern, groups: &[usize]) -> Result<(Vec<usize>, Vec<usize>)> {
+    let n = lower.n;
+    if groups.len() != n {
+        return Err(Error::LinearSolver(format!(
+            "{} elimination groups for {n} unknowns",
+            groups.len()
+        )));
+    }
+    // Group ids to 0..ng.
+    let mut id = std::collections::HashMap::new();
+    let compact: Vec<usize> = groups
+        .iter()
+        .map(|g| {
+            let next = id.len();
+            *id.entry(*g).or_insert(next)
+        })
+        .collect();
+    let ng = id.len();
+    let graph = SparsePattern::from_entries(
+        ng,
+        (0..n).flat_map(|c| {
+            let compact = &compact;
+            lower.row_idx[lower.col_ptr[c]..lower.col_ptr[c + 1]]
+                .iter()
+                .flat_map(move |&r| [(compact[r], compact[c]), (compact[c], compact[r])])
+        }),
+    );
+    let (mut fwd, mut inv) = (vec![0usize; ng], vec![0usize; ng]);
+    let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(ng, graph.nnz()))
+        .map_err(|e| Error::LinearSolver(format!("ordering workspace: {e:?}")))?;
+    let g = SymbolicSparseColMatRef::new_checked(ng, ng, &graph.col_ptr, None, &graph.row_idx);
+    amd::order(&mut fwd, &mut inv, g, Default::default(), MemStack::new(&mut buffer))
+        .map_err(|e| Error::LinearSolver(format!("ordering failed: {e:?}")))?;
+    // Members of each group, ascending (counting sort by group).
+    let mut start = vec![0usize; ng + 1];
+    for &g in &compact {
+        start[g + 1] += 1;
+    }
+    for g in 0..ng {
+        start[g + 1] += start[g];
+    }
+    let mut members = vec![0usize; n];
+    let mut fill = start.clone();
+    for (d, &g) in compact.iter().enumerate() {
+        members[fill[g]] = d;
+        fill[g] += 1;
+    }
+    let perm: Vec<usize> = fwd
+        .iter()
+        .flat_map(|&g| members[start[g]..start[g + 1]].iter().copied())
+        .collect();
+    let mut inverse = vec![0usize; n];
+    for (new, &old) in perm.iter().enumerate() {
+        inverse[old] = new;
+    }
+    Ok((perm, inverse))
+}
+
+/// Why a numeric factorization without pivoting stopped.
+#[derive(Debug)]
+pub struct PivotFailure {
+    /// Permuted column whose pivot was refused.
+    pub column: usize,
+    pub pivot: f64,
+    pub column_max: f64,
+}
+
+/// The numeric factors on a [`SymbolicSymmetricLu`] structure, with their workspace (kept
+/// between calls: a Newton iteration allocates nothing).
+#[derive(Default)]
+pub struct NumericSymmetricLu {
+    values: Vec<f64>,
+    position: Vec<usize>,
+    product: Vec<f64>,
+    work: Vec<f64>,
+}
+
+impl NumericSymmetricLu {
+    /// Factorizes the matrix with values `a` on the analysed pattern.
+    pub fn factorize(
+        &mut self,
+        symbolic: &SymbolicSymmetricLu,
+        a: &[f64],
+    ) -> std::result::Result<(), PivotFailure> {
+        let sy = symbolic;
+        self.values.clear();
+        self.values.resize(sy.len, 0.0);
+        self.position.resize(sy.n, 0);
+        for (&v, &k) in a.iter().zip(&sy.slot) {
+            self.values[k] = v;
+        }
+        for s in 0..sy.begin.len() - 1 {
+            let (f, k, r, rows) = sy.panels(s);
+            let m = k + r;
+            for j in 0..k {
+                self.position[f + j] = j;
+            }
+            for (p, &g) in rows.iter().enumerate() {
+                self.position[g] = k + p;
+            }
+            let (done, rest) = self.values.split_at_mut(sy.offset[s]);
+            let (l_panel, rest) = rest.split_at_mut(m * k);
+            let u_panel = &mut rest[..r * k];
+            for up in &sy.updates[sy.update_ptr[s]..sy.update_ptr[s + 1]] {
+                let (_, kd, rd, rows_d) = sy.panels(up.d);
+                let md = kd + rd;
+                let base = sy.offset[up.d];
+                let ld = MatRef::from_column_major_slice(&done[base..base + md * kd], md, kd);
+                let ud = MatRef::from_column_major_slice(&done[base + md * kd..][..rd * kd], rd, kd);
+                let (nr, nc) = (rd - up.p1, up.p2 - up.p1);
+                // L: rows p1.. of d times U's columns p1..p2.
+                let l_rows = ld.subrows(kd + up.p1, nr);
+                let u_cols = ud.subrows(up.p1, nc);
+                dense_product(&mut self.product, l_rows, u_cols, nr, nc);
+                for c in 0..nc {
+                    let col = rows_d[up.p1 + c] - f;
+                    let target = &mut l_panel[col * m..(col + 1) * m];
+                    for (i, &g) in rows_d[up.p1..].iter().enumerate() {
+                        target[self.position[g]] -= self.product[i + c * nr];
+                    }
+                }
+                // U^T: rows p2.. of d's U^T panel times L's rows p1..p2.
+                let nu = rd - up.p2;
+                if nu > 0 {
+                    let u_rows = ud.subrows(up.p2, nu);
+                    let l_cols = ld.subrows(kd + up.p1, nc);
+                    dense_product(&mut self.product, u_rows, l_cols, nu, nc);
+                    for c in 0..nc {
+                        let col = rows_d[up.p1 + c] - f;
+                        let target = &mut u_panel[col * r..(col + 1) * r];
+                        for (i, &g) in rows_d[up.p2..].iter().enumerate() {
+                            target[self.position[g] - k] -= self.product[i + c * nu];
+                        }
+                    }
+                }
+            }
+            // The pivot test's scale: the largest entry of the column of L and row of U.
+            self.work.clear();
+            for j in 0..k {
+                // Column j of L from the diagonal down, row j of U right of the diagonal.
+                let column = l_panel[j * m + j..(j + 1) * m].iter();
+                let row = (j + 1..k).map(|c| &l_panel[c * m + j]);
+                let row_beyond = u_panel[j * r..(j + 1) * r].iter();
+                let max = column
+                    .chain(row)
+                    .chain(row_beyond)
+                    .fold(0.0f64, |a, v| a.max(v.abs()));
+                self.work.push(max);
+            }
+            let mut panel = MatMut::from_column_major_slice_mut(l_panel, m, k);
+            let (mut diagonal, _, mut below, _) = panel.rb_mut().split_at_mut(k, k);
+            lu_no_pivoting(diagonal.rb_mut());
+            for j in 0..k {
+                let pivot = diagonal[(j, j)];
+                if !(pivot.is_finite() && pivot.abs() > PIVOT_TOLERANCE * self.work[j]) {
+                    return Err(PivotFailure {
+                        column: f + j,
+                        pivot,
+                        column_max: self.work[j],
+                    });
+                }
+            }
+            if r > 0 {
+                // L_Rs U_ss = A_Rs  <=>  U_ss^T L_Rs^T = A_Rs^T.
+                solve_lower_triangular_in_place(
+                    diagonal.rb().transpose(),
+                    below.rb_mut().transpose_mut(),
+                    Par::Seq,
+                );
+                // L_ss U_sR = A_sR, with U_sR^T stored.
+                let mut ut = MatMut::from_column_major_slice_mut(u_panel, r, k);
+                solve_unit_lower_triangular_in_place(diagonal.rb(), ut.rb_mut().transpose_mut(), Par::Seq);
+            }
+        }
+        Ok(())
+    }
+
+    /// Solves `A X = B` in place for `nrhs` right-hand sides stored column after column.
+    /// O(nnz(L + U) nrhs).
+    pub fn solve_in_place(&mut self, symbolic: &SymbolicSymmetricLu, b: &mut [f64], nrhs: usize) {
+        let sy = symbolic;
+        let n = sy.n;
+        self.work.clear();
+        self.work.resize(n * nrhs, 0.0);
+        let x = &mut self.work;
+        for c in 0..nrhs {
+            for (new, &old) in sy.perm.iter().enumerate() {
+                x[c * n + new] = b[c * n + old];
+            }
+        }
+        let ns = sy.begin.len() - 1;
+        // L y = P b.
+        for s in 0..ns {
+            let (f, k, r, rows) = sy.panels(s);
+            let m = k + r;
+            let panel = MatRef::from_column_major_slice(&self.values[sy.offset[s]..][..m * k], m, k);
+            let diagonal = panel.subrows(0, k);
+            for c in 0..nrhs {
+                let xc = &mut x[c * n..(c + 1) * n];
+                let block = MatMut::from_column_major_slice_mut(&mut xc[f..f + k], k, 1);
+                solve_unit_lower_triangular_in_place(diagonal, block, Par::Seq);
+                for j in 0..k {
+                    let v = xc[f + j];
+                    if v != 0.0 {
+                        let col = &self.values[sy.offset[s] + j * m + k..][..r];
+                        for (l, &g) in col.iter().zip(rows) {
+                            xc[g] -= l * v;
+                        }
+                    }
+                }
+            }
+        }
+        // U x = y.
+        for s in (0..ns).rev() {
+            let (f, k, r, rows) = sy.panels(s);
+            let m = k + r;
+            let panel = MatRef::from_column_major_slice(&self.values[sy.offset[s]..][..m * k], m, k);
+            let diagonal = panel.subrows(0, k);
+            for c in 0..nrhs {
+                let xc = &mut x[c * n..(c + 1) * n];
+                for j in 0..k {
+                    let col = &self.values[sy.offset[s] + m * k + j * r..][..r];
+                    let dot: f64 = col.iter().zip(rows).map(|(u, &g)| u * xc[g]).sum();
+                    xc[f + j] -= dot;
+                }
+                let block = MatMut::from_column_major_slice_mut(&mut xc[f..f + k], k, 1);
+                solve_upper_triangular_in_place(diagonal, block, Par::Seq);
+            }
+        }
+        for c in 0..nrhs {
+            for (new, &old) in sy.perm.iter().enumerate() {
+                b[c * n + old] = x[c * n + new];
+            }
+        }
+    }
+}
+
+/// `out (rows x cols, column-major) = a b^T` for `a` (rows x k) and `b` (cols x k). Small
+/// products by plain loops (faer's dispatch costs more than a few hundred flops).
+fn dense_product(out: &mut Vec<f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>, rows: usize, cols: usize) {
+    out.clear();
+    out.resize(rows * cols, 0.0);
+    let k = a.ncols();
+    if rows * cols * k <= 512 {
+        for c in 0..cols {
+            for p in 0..k {
+                let w = b[(c, p)];
+                if w != 0.0 {
+                    let column = a.col(p);
+                    for i in 0..rows {
+                        out[i + c * rows] += column[i] * w;
+                    }
+                }
+            }
+        }
+    } else {
+        let dst = MatMut::from_column_major_slice_mut(out, rows, cols);
+        matmul(dst, Accum::Replace, a, b.transpose(), 1.0, Par::Seq);
+    }
+}
+
+/// In-place LU without pivoting of a dense square block: unit lower L below the diagonal,
+/// U on and above. Recursive halving, so that the bulk of the flops is in faer's matmul and
+/// triangular solves. O(k^3) flops.
+fn lu_no_pivoting(mut a: MatMut<'_, f64>) {
+    let n = a.nrows();
+    if n <= 16 {
+        for j in 0..n {
+            let pivot = a[(j, j)];
+            for i in j + 1..n {
+                a[(i, j)] /= pivot;
+            }
+            for c in j + 1..n {
+                let u = a[(j, c)];
+                if u != 0.0 {
+                    for i in j + 1..n {
+                        let l = a[(i, j)];
+                        a[(i, c)] -= l * u;
+                    }
+                }
+            }
+        }
+        return;
+    }
+    let h = n / 2;
+    let (mut a11, mut a12, mut a21, mut a22) = a.split_at_mut(h, h);
+    lu_no_pivoting(a11.rb_mut());
+    solve_unit_lower_triangular_in_place(a11.rb(), a12.rb_mut(), Par::Seq);
+    solve_lower_triangular_in_place(a11.rb().transpose(), a21.rb_mut().transpose_mut(), Par::Seq);
+    matmul(a22.rb_mut(), Accum::Add, a21.rb(), a12.rb(), -1.0, Par::Seq);
+    lu_no_pivoting(a22);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::linear::{FaerLu, LinearSolver, SymmetricLu};
+    use super::super::sparse::{SparseMatrix, SparsePattern};
+    use std::sync::Arc;
+
+    /// A small deterministic generator (no test depends on a crate's random stream).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((self.0 >> 11) as f64) / ((1u64 << 53) as f64)
+        }
+    }
+
+    /// A random structurally symmetric pattern (a 3D-grid-like graph plus random couplings)
+    /// with unsymmetric values and a dominant diagonal.
+    fn random_matrix(n: usize, seed: u64) -> SparseMatrix {
+        let mut rng = Lcg(seed);
+        let mut entries = Vec::new();
+        for i in 0..n {
+            entries.push((i, i));
+            for d in [1, 7, 29] {
+                if i + d < n && rng.next() < 0.8 {
+                    entries.push((i, i + d));
+                    entries.push((i + d, i));
+                }
+            }
+            let j = (rng.next() * n as f64) as usize % n;
+            entries.push((i, j));
+            entries.push((j, i));
+        }
+        let p = Arc::new(SparsePattern::from_entries(n, entries));
+        let mut a = SparseMatrix::zeros(p.clone());
+        for v in a.values.iter_mut() {
+            *v = rng.next() * 2.0 - 1.0;
+        }
+        let sums = a.row_abs_sums();
+        for i in 0..n {
+            let k = p.position(i, i).unwrap();
+            a.values[k] = sums[i] + 1.0;
+        }
+        a
+    }
+
+    fn dense_solve(a: &SparseMatrix, b: &[f64]) -> Vec<f64> {
+        let n = a.pattern.n;
+        let mut m = nalgebra::DMatrix::<f64>::zeros(n, n);
+        for c in 0..n {
+            for k in a.pattern.col_ptr[c]..a.pattern.col_ptr[c + 1] {
+                m[(a.pattern.row_idx[k], c)] = a.values[k];
+            }
+        }
+        m.lu().solve(&nalgebra::DVector::from_column_slice(b)).unwrap().as_slice().to_vec()
+    }
+
+    #[test]
+    fn equals_a_dense_solve_on_random_diagonally_dominant_matrices() {
+        for (n, seed) in [(1, 1), (5, 2), (60, 3), (300, 4), (900, 5)] {
+            let a = random_matrix(n, seed);
+            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.5).collect();
+            let b = a.mul_vec(&x);
+            let mut solver = SymmetricLu::default();
+            let mut y = b.clone();
+            solver.solve(&a, &mut y).unwrap();
+            let reference = dense_solve(&a, &b);
+            // Diagonally dominant, condition number O(10): errors are round-off, ~1e-15.
+            for i in 0..n {
+                assert!((y[i] - reference[i]).abs() < 1e-12, "n {n}, unknown {i}");
+                assert!((y[i] - x[i]).abs() < 1e-12, "n {n}, unknown {i}");
+            }
+            assert_eq!(solver.fallback_count, 0, "no pivot is small here");
+            assert!(solver.factor_len().unwrap() >= a.pattern.nnz());
+            // The same pattern with other values reuses the analysis.
+            let mut a2 = a.clone();
+            a2.values.iter_mut().for_each(|v| *v *= 1.5);
+            let mut y2 = a2.mul_vec(&x);
+            solver.solve(&a2, &mut y2).unwrap();
+            assert_eq!(solver.symbolic_count, 1);
+            for i in 0..n {
+                assert!((y2[i] - x[i]).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn several_right_hand_sides_and_a_border_equal_the_pivoting_lu() {
+        let a = random_matrix(200, 9);
+        let b: Vec<f64> = (0..200).map(|i| (i as f64).cos()).collect();
+        for border in [vec![], vec![17], vec![3, 150, 99]] {
+            let (mut y, mut z) = (b.clone(), b.clone());
+            SymmetricLu::default().solve_bordered(&a, &mut y, &border).unwrap();
+            FaerLu::default().solve_bordered(&a, &mut z, &border).unwrap();
+            for i in 0..200 {
+                assert!((y[i] - z[i]).abs() < 1e-12, "border {border:?}, unknown {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_zero_pivot_falls_back_to_the_pivoting_lu() {
+        // [[0, 1], [1, 1]]: regular, but its first pivot is 0 in any symmetric order that
+        // puts unknown 0 first; and [[1, 1], [1, 0]] in the other order. Both are solved.
+        let p = Arc::new(SparsePattern::from_entries(2, [(0, 0), (1, 1), (0, 1), (1, 0)]));
+        for diagonal in [[0.0, 1.0], [1.0, 0.0]] {
+            let mut a = SparseMatrix::zeros(p.clone());
+            a.add(0, 0, diagonal[0]);
+            a.add(1, 1, diagonal[1]);
+            a.add(0, 1, 1.0);
+            a.add(1, 0, 1.0);
+            let x = [2.0, -3.0];
+            let mut b = a.mul_vec(&x);
+            let mut solver = SymmetricLu::default();
+            solver.solve(&a, &mut b).unwrap();
+            assert!((b[0] - x[0]).abs() < 1e-14 && (b[1] - x[1]).abs() < 1e-14, "{b:?}");
+            // Either the zero pivot came first and was refused, or the order avoided it.
+            assert!(solver.fallback_count <= 1);
+        }
+        // Zero pivot in a saddle-point system: [[2, 0, 1], [0, 3, 1], [1, 1, 0]].
+        let entries = [(0, 0), (1, 1), (2, 2), (0, 2), (2, 0), (1, 2), (2, 1)];
+        let p = Arc::new(SparsePattern::from_entries(3, entries));
+        let mut a = SparseMatrix::zeros(p);
+        for (r, c, v) in [(0, 0, 2.0), (1, 1, 3.0), (0, 2, 1.0), (2, 0, 1.0), (1, 2, 1.0), (2, 1, 1.0)] {
+            a.add(r, c, v);
+        }
+        let x = [1.0, -2.0, 0.5];
+        let mut b = a.mul_vec(&x);
+        SymmetricLu::default().solve(&a, &mut b).unwrap();
+        for i in 0..3 {
+            assert!((b[i] - x[i]).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn a_tiny_pivot_is_refused_and_the_fallback_is_used() {
+        // Unknown 0's pivot is 1e-14 against off-diagonal entries of 1: no pivoting would
+        // amplify round-off by 1e14. The answer must still be right.
+        let p = Arc::new(SparsePattern::from_entries(2, [(0, 0), (1, 1), (0, 1), (1, 0)]));
+        let mut a = SparseMatrix::zeros(p);
+        for (r, c, v) in [(0, 0, 1e-14), (1, 1, 1e-14), (0, 1, 1.0), (1, 0, 1.0)] {
+            a.add(r, c, v);
+        }
+        let x = [0.3, 0.7];
+        let mut b = a.mul_vec(&x);
+        let mut solver = SymmetricLu::default();
+        solver.solve(&a, &mut b).unwrap();
+        assert_eq!(solver.fallback_count, 1);
+        assert!((b[0] - x[0]).abs() < 1e-14 && (b[1] - x[1]).abs() < 1e-14, "{b:?}");
+    }
+
+    #[test]
+    fn a_singular_matrix_is_an_error_not_a_panic() {
+        let p = Arc::new(SparsePattern::from_entries(2, [(0, 0), (1, 1), (0, 1), (1, 0)]));
+        let mut a = SparseMatrix::zeros(p);
+        for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            a.add(r, c, 1.0);
+        }
+        let mut b = vec![1.0, 2.0];
+        let mut solver = SymmetricLu::default();
+        assert!(solver.solve(&a, &mut b).is_err());
+        assert_eq!(solver.fallback_count, 1);
+        let mut nan = a.clone();
+        nan.values[0] = f64::NAN;
+        assert!(solver.solve(&nan, &mut [1.0, 2.0]).is_err());
+    }
+}

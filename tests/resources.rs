@@ -1,0 +1,215 @@
+//! Resource bounds through the command line: a mesh too large for the memory limit is refused
+//! before it is allocated (the process's peak memory stays small), huge increment counts and
+//! a 1e308 path are refused or bounded, output size is capped, and endless script loops stop
+//! with the limit's message, quickly.
+
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+struct Outcome {
+    code: i32,
+    stderr: String,
+    /// Peak resident memory of the child, bytes (from `wait4`).
+    peak: u64,
+    wall: Duration,
+}
+
+fn dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tribo-res-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs `tribo run` on `source` (120 s limit), waiting with `wait4` to read the child's peak
+/// memory.
+fn run(tag: &str, source: &str, extra: &[&str]) -> Outcome {
+    let d = dir(tag);
+    let script = d.join("s.rhai");
+    std::fs::write(&script, source).unwrap();
+    let err_file = d.join("stderr.txt");
+    let child = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .arg("run")
+        .arg(&script)
+        .args(["--quiet", "--out"])
+        .arg(d.join("out"))
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&err_file).unwrap())
+        .spawn()
+        .unwrap();
+    let pid = child.id() as libc::pid_t;
+    let start = Instant::now();
+    let (status, usage) = loop {
+        let mut status = 0;
+        // SAFETY: plain wait4 on our own child, results written into locals.
+        let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+        let r = unsafe { libc::wait4(pid, &mut status, libc::WNOHANG, &mut usage) };
+        if r == pid {
+            break (status, usage);
+        }
+        assert!(r == 0, "wait4 failed");
+        if start.elapsed() > Duration::from_secs(120) {
+            unsafe { libc::kill(pid, libc::SIGKILL) };
+            panic!("{tag}: no stop within 120 s");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    let wall = start.elapsed();
+    std::mem::forget(child);
+    assert!(libc::WIFEXITED(status), "{tag}: ended by a signal");
+    let stderr = std::fs::read_to_string(&err_file).unwrap();
+    assert!(!stderr.contains("panicked"), "{tag}: panic: {stderr}");
+    Outcome {
+        code: libc::WEXITSTATUS(status),
+        stderr,
+        peak: usage.ru_maxrss as u64 * 1024,
+        wall,
+    }
+}
+
+#[test]
+fn a_mesh_over_the_memory_limit_is_refused_before_allocation() {
+    // 4001 x 1001 x 2 nodes: ~8 M nodes, hundreds of GB by the estimate.
+    let src = "let cells = 4000;\nlet mesh = block([0, 0, 0], [16, 4, 1], [cells, cells / 4, 1]);\n\
+               let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n";
+    let o = run("mesh", src, &[]);
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("a mesh of 8010002 nodes needs about")
+            && o.stderr.contains("over the memory limit of")
+            && o.stderr.contains("this machine has")
+            && o.stderr.contains("s.rhai:2:"),
+        "{}",
+        o.stderr
+    );
+    // Refused before building: the whole process stayed far below the mesh's own arrays.
+    assert!(o.peak < 64 << 20, "peak memory {} bytes", o.peak);
+    // The limit is the user's: a lower one refuses a mesh the default accepts.
+    let small = "let mesh = block([0, 0, 0], [1, 1, 1], [30, 30, 30]);\n";
+    assert_eq!(run("mesh-ok", small, &[]).code, 0);
+    let o = run("mesh-low", small, &["--max-memory-mb", "100"]);
+    assert!(o.stderr.contains("over the memory limit of 100 MiB"), "{}", o.stderr);
+}
+
+#[test]
+fn script_memory_is_bounded() {
+    // 60 nested calls each holding a 4 Mi-element array (~4 GB if unbounded).
+    let src = "fn f(n) { let a = []; a.pad(4000000, 1.0); if n > 0 { f(n - 1) } else { 0 } }\nf(60);\n";
+    let o = run("recursion", src, &["--max-memory-mb", "400"]);
+    assert_eq!(o.code, 1);
+    assert!(
+        o.stderr.contains("over the limit of 400 MiB (raise it with --max-memory-mb)"),
+        "{}",
+        o.stderr
+    );
+    // Stopped within a few arrays (64 MiB each) of the limit.
+    assert!(o.peak < 800 << 20, "peak memory {} bytes", o.peak);
+}
+
+#[test]
+fn endless_loops_stop_with_the_limit_message() {
+    let o = run("loop", "let i = 0;\nloop { i += 1; }\n", &[]);
+    assert_eq!(o.code, 1);
+    assert!(o.stderr.contains("s.rhai:2:") && o.stderr.contains("Too many operations"), "{}", o.stderr);
+    assert!(o.wall < Duration::from_secs(60), "{:?}", o.wall);
+
+    // Each push re-measures the array (quadratic): the operation count alone would take
+    // hours; the script-time limit stops it.
+    let o = run("push", "let a = [];\nloop { a.push(1); }\n", &["--max-script-seconds", "2"]);
+    assert_eq!(o.code, 1);
+    assert!(
+        o.stderr.contains("s.rhai:2:")
+            && o.stderr.contains("over the limit of 2 s (raise it with --max-script-seconds)"),
+        "{}",
+        o.stderr
+    );
+    assert!(o.wall < Duration::from_secs(30), "{:?}", o.wall);
+}
+
+const SCENE: &str = r#"
+let mesh = block([0, 0, 0], [1, 1, 1], [2, 2, 2]);
+let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
+let travel = 0.05;
+let roller = tool("roller", cylinder([0, 0, 2], [0, 1, 0], 1.0)).path([[0, 0, 0, 0], [1, 0, 0, -travel]]);
+sim.add_tool(roller, "z+");
+sim.fix("z-", "xyz");
+"#;
+
+#[test]
+fn increments_and_paths_are_bounded() {
+    let o = run("1e12", &format!("{SCENE}sim.settings(#{{ increments: 1e12 }});\n"), &[]);
+    assert_eq!(o.code, 1);
+    assert!(
+        o.stderr.contains("increments = 1000000000000 must be a whole number from 1 to 100000"),
+        "{}",
+        o.stderr
+    );
+    // A 1e308 path under adaptive stepping: stopped by the increments cap (here lowered).
+    let src = format!(
+        "{}sim.settings(#{{ step_control: \"adaptive\" }});\nsim.run();\n",
+        SCENE.replace("let travel = 0.05;", "let travel = 1e308;")
+    );
+    let o = run("1e308", &src, &["--max-increments", "20"]);
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("taken 20 increments, the limit") || o.stderr.contains("non-finite"),
+        "{}",
+        o.stderr
+    );
+    assert!(o.wall < Duration::from_secs(60), "{:?}", o.wall);
+    let out = std::env::temp_dir().join(format!("tribo-res-{}-1e308/out", std::process::id()));
+    assert!(folder_bytes(&out) < 1 << 20, "{} bytes written", folder_bytes(&out));
+
+    // A run that would go on: stopped by the increments cap with its message.
+    let src = format!("{SCENE}sim.settings(#{{ increments: 50 }});\nsim.run();\n");
+    let o = run("cap", &src, &["--max-increments", "50"]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let src = format!("{SCENE}sim.settings(#{{ increments: 50 }});\nsim.run();\n");
+    let o = run("cap-low", &src, &["--max-increments", "10"]);
+    assert!(o.stderr.contains("increments = 50 must be a whole number from 1 to 10"), "{}", o.stderr);
+    let src = format!(
+        "{SCENE}sim.settings(#{{ increments: 5, step_control: \"adaptive\", dt_max: 0.01, dt_initial: 0.01 }});\nsim.run();\n"
+    );
+    let o = run("cap-run", &src, &["--max-increments", "10"]);
+    assert!(o.stderr.contains("taken 10 increments, the limit (raise it with --max-increments)"), "{}", o.stderr);
+}
+
+fn folder_bytes(dir: &std::path::Path) -> u64 {
+    std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .map(|e| {
+                    let e = e.unwrap();
+                    let m = e.metadata().unwrap();
+                    if m.is_dir() {
+                        folder_bytes(&e.path())
+                    } else {
+                        m.len()
+                    }
+                })
+                .sum()
+        })
+        .unwrap_or(0)
+}
+
+#[test]
+fn output_size_is_capped() {
+    let src = "let s = \"x\"; for j in 0..19 { s += s; }\nlet i = 0;\nloop { i += 1; write_text(`f${i}.txt`, s); }\n";
+    let o = run("disk", src, &["--max-output-mb", "8"]);
+    assert_eq!(o.code, 1);
+    assert!(
+        o.stderr.contains("over the limit of 8388608 bytes (raise it with --max-output-mb)")
+            && o.stderr.contains("s.rhai:3:"),
+        "{}",
+        o.stderr
+    );
+    let d = std::env::temp_dir().join(format!("tribo-res-{}-disk/out", std::process::id()));
+    let written: u64 = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().metadata().unwrap().len())
+        .sum();
+    // At most one file (512 KiB) over the cap.
+    assert!(written <= (8 << 20) + (512 << 10), "{written} bytes written");
+}
