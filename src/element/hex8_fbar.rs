@@ -95,20 +95,15 @@ impl Default for Hex8FBar {
 /// The displacement gradient `H = Σ u_a ⊗ b_a` (`F = I + H`). Kept apart from `F`:
 /// strains of `10⁻⁶` (a stiff sheet in bending) would keep only ~10 digits in `I + H`,
 /// and the material forms its strain from `H` (see `material::log_strain`).
-fn displacement_gradient(u: &[Vec3; NODES], b: &[Vec3; NODES]) -> Mat3 {
+pub(super) fn displacement_gradient(u: &[Vec3; NODES], b: &[Vec3; NODES]) -> Mat3 {
     (0..NODES).fold(Mat3::zeros(), |h, a| h + u[a] * b[a].transpose())
 }
 
 /// `ln det(I + h)` from `det(I + h) - 1 = tr h + ½((tr h)² - tr h²) + det h`, to the
 /// relative precision of `h` (no cancellation against 1). `det(I + h) > 0` is the caller's.
-fn ln_det_one_plus(h: &Mat3) -> f64 {
+pub(super) fn ln_det_one_plus(h: &Mat3) -> f64 {
     let tr = h.trace();
     (tr + 0.5 * (tr * tr - (h * h).trace()) + h.determinant()).ln_1p()
-}
-
-/// `F = I + Σ u_a ⊗ b_a`.
-pub(super) fn gradient(u: &[Vec3; NODES], b: &[Vec3; NODES]) -> Mat3 {
-    (0..NODES).fold(Mat3::identity(), |f, a| f + u[a] * b[a].transpose())
 }
 
 /// Inverse-transpose of a deformation gradient with a positive determinant; `what` names

@@ -6,9 +6,11 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::hex8::{checked_inputs, DOFS, NODES, POINTS};
-use super::hex8_fbar::{centre_gradients, gradient, inverse_transpose, Hex8FBar, PAIRS};
+use super::hex8_fbar::{
+    centre_gradients, displacement_gradient, inverse_transpose, ln_det_one_plus, Hex8FBar, PAIRS,
+};
 use super::{prefix, ElementResponse};
-use crate::geometry::Vec3;
+use crate::geometry::{Mat3, Vec3};
 use crate::material::{stress_to_tensor, Material, PointState};
 use crate::Result;
 
@@ -23,30 +25,38 @@ pub fn evaluate(
 ) -> Result<ElementResponse<DOFS>> {
     let (x, u, geo) = checked_inputs(ref_coords, u, committed, trial)?;
     let b0 = centre_gradients(&x)?;
-    let (f0_inv_t, j0) = inverse_transpose(&gradient(&u, &b0), || "the element centre".into())?;
+    // The strain from the displacement gradient, as the tuned kernel (round-off of small
+    // strains, see `material::log_strain`); the rest is the original kernel.
+    let h0 = displacement_gradient(&u, &b0);
+    let (f0_inv_t, _) =
+        inverse_transpose(&(Mat3::identity() + h0), || "the element centre".into())?;
+    let ln_j0 = ln_det_one_plus(&h0);
     let g0: [Vec3; NODES] = std::array::from_fn(|a| f0_inv_t * b0[a]);
 
     let mut force = SVector::<f64, DOFS>::zeros();
     let mut stiffness = SMatrix::<f64, DOFS, DOFS>::zeros();
     for gp in 0..POINTS {
         let b = &geo.grad[gp];
-        let f = gradient(&u, b);
-        let (f_inv_t, j) = {
+        let h = displacement_gradient(&u, b);
+        let f = Mat3::identity() + h;
+        let (f_inv_t, _) = {
             // As before: the place name is formatted at every point, failure or not.
             let what = format!("integration point {gp}");
             inverse_transpose(&f, || what.clone())
         }?;
         let g: [Vec3; NODES] = std::array::from_fn(|a| f_inv_t * b[a]);
-        let (r, q) = if el.fbar {
+        let (r_minus_one, q) = if el.fbar {
             let q =
                 SVector::<f64, DOFS>::from_fn(|i, _| (g0[i / 3][i % 3] - g[i / 3][i % 3]) / 3.0);
-            ((j0 / j).cbrt(), q)
+            (((ln_j0 - ln_det_one_plus(&h)) / 3.0).exp_m1(), q)
         } else {
-            (1.0, SVector::<f64, DOFS>::zeros())
+            (0.0, SVector::<f64, DOFS>::zeros())
         };
+        let r = 1.0 + r_minus_one;
         let fb = f * r;
+        let hb = Mat3::identity() * r_minus_one + h * r;
         let resp = material
-            .update_finite(&fb, &committed[gp], &mut trial[gp])
+            .update_finite_displacement_gradient(&hb, &committed[gp], &mut trial[gp])
             .map_err(|e| prefix(e, &format!("integration point {gp}")))?;
         let s = stress_to_tensor(&resp.pk2);
         let p = fb * s;
