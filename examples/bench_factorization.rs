@@ -82,10 +82,20 @@ fn main() {
         sym.factor_len().map_or("?".into(), |l| l.to_string()),
         sym.fallback_count
     );
+    // Backward errors |b - A x| / (|A| |x| + |b|) (infinity norms); without a border.
+    let norm_a = a.row_abs_sums().into_iter().fold(0.0, f64::max);
+    let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let backward = |x: &[f64]| {
+        let r: Vec<f64> = rhs.iter().zip(a.mul_vec(x)).map(|(b, y)| b - y).collect();
+        inf(&r) / (norm_a * inf(x) + inf(&rhs))
+    };
     println!(
-        "solutions differ by {:.1e} of the largest entry; speed-up {:.2}x",
+        "solutions differ by {:.1e} of the largest entry; backward errors: LU {:.1e}, symmetric LU {:.1e}; speed-up {:.2}x wall, {:.2}x CPU",
         diff / scale,
-        lu_wall / sym_wall
+        backward(&x_lu),
+        backward(&x_sym),
+        lu_wall / sym_wall,
+        lu_cpu / sym_cpu
     );
     if only_new {
         return;
