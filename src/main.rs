@@ -209,7 +209,9 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e @ tribo::Error::Interrupted(_)) => {
-            eprintln!("{e}: the last converged state and summary.json are in the output folder");
+            eprintln!(
+                "{e}: summary.json and checkpoints/final.json (the last converged state) are in the output folder of each simulation that had started"
+            );
             ExitCode::from(tribo::interrupt::EXIT_INTERRUPTED)
         }
         Err(e) => {

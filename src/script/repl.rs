@@ -83,6 +83,9 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
                     }
                     _ => {}
                 }
+                // A signal that arrived while the prompt waited (kill -INT) is not meant for
+                // this line.
+                host.interrupt.clear();
                 let result = engine.eval_with_scope::<Dynamic>(&mut scope, line);
                 let text = outcome_line(&result, host);
                 if !text.is_empty() {
