@@ -210,6 +210,11 @@ pub fn parse_override(text: &str) -> Result<(String, Dynamic)> {
     let dynamic = if let Ok(i) = v.parse::<i64>() {
         Dynamic::from(i)
     } else if let Ok(f) = v.parse::<f64>() {
+        if !f.is_finite() {
+            return Err(Error::Input(format!(
+                "--set {name}={v}: the value must be a finite number"
+            )));
+        }
         Dynamic::from(f)
     } else if let Ok(b) = v.parse::<bool>() {
         Dynamic::from(b)
@@ -248,7 +253,15 @@ pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions
     let mut scope = Scope::new();
     engine
         .run_ast_with_scope(&mut scope, &ast)
-        .map_err(|e| Error::Script(describe_error(&path.display().to_string(), &e)))
+        .map_err(|e| Error::Script(describe_error(&path.display().to_string(), &e)))?;
+    match &host.restart {
+        Some(ck) if !host.restart_used.get() => Err(Error::Input(format!(
+            "--restart {}: the script {} started no simulation, so the checkpoint was not used",
+            ck.display(),
+            path.display()
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// `--set NAME=VALUE` replaces the value of the script's top-level `let NAME = ...;`
@@ -280,7 +293,10 @@ pub fn apply_overrides(
                         path.display()
                     )));
                 }
-                patched.push_str(&format!("let {name} = {};", literal(value)));
+                let declared = code
+                    .split_once('=')
+                    .map_or("", |(_, d)| d.trim().trim_end_matches(';').trim());
+                patched.push_str(&format!("let {name} = {};", literal(&as_declared(value, declared))));
                 seen[i] = true;
                 replaced = true;
                 break;
@@ -305,6 +321,16 @@ pub fn apply_overrides(
         .map_err(|e| Error::Script(format!("{file}: after --set: {e}")))?;
     ast.set_source(file);
     Ok(ast)
+}
+
+/// An integer given for a declaration written as a float literal (`let step = 0.5;` with
+/// `--set step=1`) becomes a float, so the script's float arithmetic keeps working.
+fn as_declared(value: &Dynamic, declared: &str) -> Dynamic {
+    let float_literal = declared.parse::<f64>().is_ok() && declared.parse::<i64>().is_err();
+    match value.as_int() {
+        Ok(i) if float_literal => Dynamic::from(i as f64),
+        _ => value.clone(),
+    }
 }
 
 fn literal(v: &Dynamic) -> String {
