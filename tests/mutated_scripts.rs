@@ -1,5 +1,11 @@
 //! 1 000 randomly mutated versions of the demo script: each either runs or stops with an
-//! error, and none panics (errors are expected and fine).
+//! error, and none panics (errors are expected and fine). Then a seeded sample of the
+//! mutation campaign over all shipped scripts (examples/mutation_campaign): each mutant run
+//! as `tribo run` with a time limit; no panic, hang or signal, and every error names the
+//! place (file:line:column) or the value.
+
+#[path = "../examples/mutation_campaign/mutate.rs"]
+mod mutate;
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
@@ -97,3 +103,67 @@ fn mutated_scripts_never_panic() {
         "the mutations exercise both outcomes"
     );
 }
+
+#[test]
+fn campaign_sample_of_shipped_script_mutants() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let bin = PathBuf::from(env!("CARGO_BIN_EXE_tribo"));
+    let mut pool = Vec::new();
+    for s in mutate::shipped_scripts(&root) {
+        let src = std::fs::read_to_string(&s).unwrap();
+        for (what, text) in mutate::mutants(&src) {
+            pool.push((s.clone(), what, text));
+        }
+    }
+    assert!(pool.len() > 3000, "the campaign has {} mutants to choose from", pool.len());
+    let mut rng = mutate::XorShift(0x5EED_0016);
+    let sample: Vec<_> = (0..SAMPLE).map(|_| pool.swap_remove(rng.below(pool.len()))).collect();
+    let queue = std::sync::Arc::new(std::sync::Mutex::new(sample));
+    let tally = std::sync::Arc::new(std::sync::Mutex::new(mutate::Tally::default()));
+    let base = std::env::temp_dir().join(format!("tribo-mutants-{}", std::process::id()));
+    let workers: Vec<_> = (0..2)
+        .map(|j| {
+            let (queue, tally, bin) = (queue.clone(), tally.clone(), bin.clone());
+            let work = base.join(format!("w{j}"));
+            std::thread::spawn(move || loop {
+                let Some((script, what, text)) = queue.lock().unwrap().pop() else {
+                    break;
+                };
+                let o = mutate::run_mutant(
+                    &bin,
+                    &script,
+                    &text,
+                    &work,
+                    std::time::Duration::from_secs(60),
+                );
+                tally
+                    .lock()
+                    .unwrap()
+                    .add(format!("{}: {what}", script.display()), &o);
+            })
+        })
+        .collect();
+    for w in workers {
+        w.join().unwrap();
+    }
+    let _ = std::fs::remove_dir_all(&base);
+    let t = tally.lock().unwrap();
+    println!(
+        "{} mutants: {} ran, {} refused, {} panics, {} hangs, {} signals",
+        t.tries,
+        t.ran,
+        t.refused,
+        t.panics.len(),
+        t.hangs.len(),
+        t.signals.len()
+    );
+    assert_eq!(t.tries, SAMPLE);
+    assert!(t.panics.is_empty(), "panics: {:#?}", t.panics);
+    assert!(t.hangs.is_empty(), "hangs: {:#?}", t.hangs);
+    assert!(t.signals.is_empty(), "signals: {:#?}", t.signals);
+    assert!(t.unlocated.is_empty(), "errors naming neither place nor value: {:#?}", t.unlocated);
+    assert!(t.ran > 0 && t.refused > 0, "both outcomes exercised");
+}
+
+/// Mutants run by the test (the full campaign runs 3 000 or more).
+const SAMPLE: usize = 200;

@@ -382,6 +382,38 @@ impl BezierPatch {
         Some(if self.flip { -c / len } else { c / len })
     }
 
+    /// Where the parametrisation folds over itself (a "bow-tie" patch): the Jacobian
+    /// `S_u x S_v`, sampled on a 16 x 16 grid of `[0, 1]^2`, reverses between two samples one
+    /// or two steps apart along u or v. Smoothly curved patches turn their normal by far less
+    /// than 90 degrees over two steps (a half cylinder: 24 degrees); a fold turns it by 180.
+    /// Degenerate samples (collapsed edges, or a sample right on the fold line) are skipped,
+    /// which is why two steps are looked at. Returns the `(u, v)` of the first reversal.
+    /// Cost: 256 evaluations.
+    pub fn fold(&self) -> Option<(f64, f64)> {
+        const N: usize = 16;
+        let at = |i: usize, j: usize| {
+            let (u, v) = (i as f64 / (N - 1) as f64, j as f64 / (N - 1) as f64);
+            let e = self.evaluate(u, v);
+            let c = e.su.cross(&e.sv);
+            let scale = e.su.norm() * e.sv.norm();
+            (c.norm() > 1e-10 * scale).then_some((c, (u, v)))
+        };
+        let grid: Vec<Vec<_>> = (0..N).map(|i| (0..N).map(|j| at(i, j)).collect()).collect();
+        for i in 0..N {
+            for j in 0..N {
+                let Some((c, uv)) = grid[i][j] else { continue };
+                for (a, b) in [(i + 1, j), (i, j + 1), (i + 2, j), (i, j + 2)] {
+                    if let Some(Some((d, _))) = grid.get(a).map(|row| row.get(b).copied().flatten()) {
+                        if c.dot(&d) < 0.0 {
+                            return Some(uv);
+                        }
+                    }
+                }
+            }
+        }
+        None
+    }
+
     /// Quarter of a cylinder: [`BezierPatch::cylinder_patch`] with a 90° sweep.
     pub fn quarter_cylinder(
         axis_point: Vec3,

@@ -94,6 +94,14 @@ impl PatchSurface {
         if patches.is_empty() {
             return Err(Error::input("patch surface patch count", 0, "must be >= 1"));
         }
+        for (k, p) in patches.iter().enumerate() {
+            if let Some((u, v)) = p.fold() {
+                return Err(Error::Input(format!(
+                    "patch {k} folds over itself: its Jacobian S_u x S_v reverses near \
+                     (u, v) = ({u:.3}, {v:.3}) (check the order of its control points)"
+                )));
+            }
+        }
         let boxes: Vec<_> = patches.iter().map(|p| p.bounding_box()).collect();
         let (lo, hi) = boxes.iter().fold(
             (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),

@@ -83,8 +83,28 @@ fn line_chart_spec(spec: &Map) -> ScriptResult<LineChart> {
             }
         }
     }
+    // Axis ticks and pixel positions are differences and multiples of the data: values near
+    // the end of the f64 range would overflow to inf and NaN there.
+    for (i, s) in chart.series.iter().enumerate() {
+        for (axis, values) in [("x", &s.x), ("y", &s.y)] {
+            if let Some((j, v)) = values
+                .iter()
+                .enumerate()
+                .find(|(_, v)| !(v.abs() <= CHART_LIMIT))
+            {
+                return fail(crate::Error::input(
+                    &format!("series[{i}].{axis}[{j}]"),
+                    v,
+                    &format!("must be finite and at most {CHART_LIMIT:e} in magnitude to be charted"),
+                ));
+            }
+        }
+    }
     Ok(chart)
 }
+
+/// Largest magnitude a chart accepts.
+const CHART_LIMIT: f64 = 1e300;
 
 /// A Rhai value as JSON; `at` names the place in the value for errors.
 fn to_json(v: &Dynamic, at: &str) -> ScriptResult<serde_json::Value> {

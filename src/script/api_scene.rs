@@ -67,6 +67,9 @@ fn register_friction(engine: &mut Engine, host: std::rc::Rc<super::HostOptions>)
     engine.register_fn(
         "mu_at",
         |law: &mut FrictionLaw, theta: f64| -> ScriptResult<f64> {
+            if !theta.is_finite() {
+                return fail(crate::Error::input("mu_at theta", theta, "must be finite"));
+            }
             match law {
                 FrictionLaw::Bernstein(l) => Ok(l.mu_of_theta(theta.clamp(0.0, 1.0))),
                 FrictionLaw::Coulomb { mu } => Ok(*mu),
@@ -389,7 +392,11 @@ pub fn scalar_schedule(value: &Dynamic) -> ScriptResult<ScalarSchedule> {
             rows.iter().map(|r| (r[0], r[1])).collect(),
         ))
     } else {
-        Ok(ScalarSchedule::constant(number(value, "value")?))
+        let v = number(value, "value")?;
+        if !v.is_finite() {
+            return fail(crate::Error::input("value", v, "must be finite"));
+        }
+        Ok(ScalarSchedule::constant(v))
     }
 }
 

@@ -101,6 +101,27 @@ fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementRepo
     Ok(report)
 }
 
+/// A tool given an empty node set can never touch the body: it would run with zero force.
+fn warn_if_no_candidates(ctx: &NativeCallContext, s: &ScriptSim, t: &Tool, set: &str) {
+    let st = s.borrow();
+    let empty = st
+        .model
+        .as_ref()
+        .and_then(|m| m.nodes(set).ok())
+        .is_some_and(|n| n.is_empty());
+    if empty && st.host.warnings {
+        let p = ctx.call_position();
+        eprintln!(
+            "warning: {}:{}:{}: tool '{}' has no candidate nodes (node set '{set}' is empty): it \
+             will exert no force",
+            ctx.call_source().unwrap_or("script"),
+            p.line().unwrap_or(0),
+            p.position().unwrap_or(0),
+            t.name
+        );
+    }
+}
+
 /// Shared handle: Rhai values are clones of it.
 pub type ScriptSim = Rc<RefCell<SimState>>;
 
@@ -716,14 +737,21 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     );
     engine.register_fn(
         "add_tool",
-        |s: &mut ScriptSim, t: Tool, set: &str| -> ScriptResult<()> {
+        |ctx: NativeCallContext, s: &mut ScriptSim, t: Tool, set: &str| -> ScriptResult<()> {
+            warn_if_no_candidates(&ctx, s, &t, set);
             lift(s.borrow_mut().model_mut()?.add_tool(t, set, None))
         },
     );
     engine.register_fn(
         "add_tool",
-        |s: &mut ScriptSim, t: Tool, set: &str, r: Dynamic| -> ScriptResult<()> {
+        |ctx: NativeCallContext,
+         s: &mut ScriptSim,
+         t: Tool,
+         set: &str,
+         r: Dynamic|
+         -> ScriptResult<()> {
             let r = number(&r, "augmentation parameter r")?;
+            warn_if_no_candidates(&ctx, s, &t, set);
             lift(s.borrow_mut().model_mut()?.add_tool(t, set, Some(r)))
         },
     );

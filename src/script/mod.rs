@@ -216,6 +216,11 @@ pub fn parse_override(text: &str) -> Result<(String, Dynamic)> {
     let dynamic = if let Ok(i) = v.parse::<i64>() {
         Dynamic::from(i)
     } else if let Ok(f) = v.parse::<f64>() {
+        if !f.is_finite() {
+            return Err(Error::Input(format!(
+                "--set {name}={v}: the value must be a finite number"
+            )));
+        }
         Dynamic::from(f)
     } else if let Ok(b) = v.parse::<bool>() {
         Dynamic::from(b)
@@ -315,7 +320,10 @@ pub fn apply_overrides(
                         path.display()
                     )));
                 }
-                patched.push_str(&format!("let {name} = {};", literal(value)));
+                let declared = code
+                    .split_once('=')
+                    .map_or("", |(_, d)| d.trim().trim_end_matches(';').trim());
+                patched.push_str(&format!("let {name} = {};", literal(&as_declared(value, declared))));
                 seen[i] = true;
                 replaced = true;
                 break;
@@ -340,6 +348,16 @@ pub fn apply_overrides(
         .map_err(|e| Error::Script(format!("{file}: after --set: {e}")))?;
     ast.set_source(file);
     Ok(ast)
+}
+
+/// An integer given for a declaration written as a float literal (`let step = 0.5;` with
+/// `--set step=1`) becomes a float, so the script's float arithmetic keeps working.
+fn as_declared(value: &Dynamic, declared: &str) -> Dynamic {
+    let float_literal = declared.parse::<f64>().is_ok() && declared.parse::<i64>().is_err();
+    match value.as_int() {
+        Ok(i) if float_literal => Dynamic::from(i as f64),
+        _ => value.clone(),
+    }
 }
 
 fn literal(v: &Dynamic) -> String {

@@ -137,6 +137,20 @@ impl Model {
     pub fn prescribe(&mut self, set: &str, components: &str, value: ScalarSchedule) -> Result<()> {
         let nodes = self.nodes(set)?;
         let comps = parse_components(components)?;
+        // A node component held twice with different values would silently take the last.
+        let held: std::collections::HashSet<usize> = nodes.iter().copied().collect();
+        for &c in &comps {
+            if let Some(d) = self.dirichlet.iter().find(|d| {
+                d.component == c && d.value != value && d.nodes.iter().any(|n| held.contains(n))
+            }) {
+                return Err(Error::Input(format!(
+                    "prescribing '{set}' {} conflicts with the earlier constraint '{}' on the \
+                     same nodes (a node component is held once; remove one of them)",
+                    ['x', 'y', 'z'][c],
+                    d.label
+                )));
+            }
+        }
         for c in comps {
             self.dirichlet.push(Dirichlet {
                 label: format!("{set}.{}", ['x', 'y', 'z'][c]),
