@@ -116,6 +116,10 @@ impl OperatorParams {
     }
 }
 
+/// |sigma| / r (a length) below which a node sits at the apex of the Coulomb cone: the
+/// default contact tolerance, so that only gaps and multipliers at round-off level count.
+const APEX_BAND: f64 = 1e-9;
+
 /// Evaluates the operator at `x`, `lambda` for the projection `proj` of `x` on the tool.
 pub fn alart_curnier(
     x: &Vec3,
@@ -190,6 +194,19 @@ pub fn alart_curnier(
         (ContactStatus::Slip, f, fx, fl, -t * (mu * sigma_n))
     };
 
+    // At the apex of the cone (a node touching with a zero multiplier, |sigma| within
+    // round-off of zero) gap, stick and slip meet and their Jacobians differ wildly: stick
+    // glues the node to the tool in all three directions, gap frees it. A barely touching
+    // node then flips between them from one iterate to the next. The frictionless normal
+    // element n (n^T dsigma), which lies in the convex hull of the slip Jacobians there, says
+    // "may press, may slide": the residual (hence the solution) is unchanged.
+    let apex = params.forced.is_none() && sigma.norm() <= APEX_BAND * r;
+    let (equi_x, equi_lambda) = if apex {
+        (n * dsigma_n_x, nn)
+    } else {
+        (equi_x, equi_lambda)
+    };
+
     NodalContact {
         status,
         f_equi,
@@ -209,6 +226,31 @@ mod tests {
     use crate::geometry::{Projection, SurfaceHint};
     // The finite-difference check of the Jacobian in every status, on a plane, a cylinder
     // and a sphere, is tests/contact_jacobian.rs.
+
+    #[test]
+    fn a_node_touching_with_zero_multiplier_gets_the_frictionless_normal_jacobian() {
+        // Zero gap, zero multiplier, no motion: sigma = 0, the apex of the cone. The force is
+        // zero whatever the status; the Jacobian constrains the normal direction only.
+        let n = Vec3::new(0.0, 0.6, 0.8);
+        let proj = Projection {
+            foot: Vec3::new(1.0, 2.0, 3.0),
+            normal: n,
+            gap: 0.0,
+            normal_gradient: Mat3::zeros(),
+            hint: SurfaceHint::default(),
+        };
+        let x = Vec3::new(1.0, 2.0, 3.0);
+        let p = OperatorParams::fixed_mu(10.0, 0.3, false);
+        let res = alart_curnier(&x, &x, &Vec3::zeros(), &proj, &p);
+        assert_eq!(res.f_equi, Vec3::zeros());
+        let nn = n * n.transpose();
+        assert!((res.equi_lambda - nn).norm() < 1e-15);
+        assert!((res.equi_x - nn * 10.0).norm() < 1e-13);
+        // Away from the apex (a multiplier of 1e-3 N) the operator is the usual one.
+        let res = alart_curnier(&x, &x, &(n * -1e-3), &proj, &p);
+        assert_eq!(res.status, ContactStatus::Stick);
+        assert!((res.equi_lambda - Mat3::identity()).norm() < 1e-15);
+    }
 
     #[test]
     fn converged_slip_state_satisfies_coulomb() {
