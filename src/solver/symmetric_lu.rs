@@ -248,9 +248,10 @@ impl SymbolicSymmetricLu {
 }
 
 /// AMD on the graph of the groups (a vertex per group, an edge where any two members are
-/// coupled), each group expanded in index order: `(new -> old, old -> new)`. Same cost as
+/// coupled), each group expanded in index order: `(new -> old, old -> new)`. `lower` is
+/// the lower triangle of `A + A^T` (or any pattern with its structure). Same cost as
 /// AMD on the unknowns, on a graph smaller by the group size.
-fn grouped_order(lower: &SparsePattern, groups: &[usize]) -> Result<(Vec<usize>, Vec<usize>)> {
+pub fn grouped_order(lower: &SparsePattern, groups: &[usize]) -> Result<(Vec<usize>, Vec<usize>)> {
     let n = lower.n;
     if groups.len() != n {
         return Err(Error::LinearSolver(format!(
