@@ -184,8 +184,12 @@ fn history(out: &Path) -> Vec<(usize, Vec<f64>)> {
 
 /// The default factorization (LU without pivoting on the symmetric structure) and faer's
 /// pivoting LU run the same cup: the same Newton iterations in every increment, forces and
-/// draw-in equal to 1e-8 of their size (Newton stops at a force residual of 1e-9; the two
-/// factorizations differ by round-off only).
+/// draw-in equal to 1e-7 of their size. Why 1e-7: the two factorizations differ by
+/// round-off only, but each increment's answer is fixed only to the Newton tolerance (a
+/// force residual of 1e-9 of the reference force), and the multipliers amplify that by
+/// the system's conditioning: measured on the benchmark variant, 1.0e-8 of the largest
+/// force in increment 1 (first contact of the flat blank, the last residual just under the
+/// tolerance), 1.1e-9 in increment 2, below 3e-11 after.
 #[test]
 fn both_linear_solvers_give_the_same_cup() {
     for variant in ["paper", "benchmark"] {
@@ -198,7 +202,7 @@ fn both_linear_solvers_give_the_same_cup() {
         for ((ia, fa), (ib, fb)) in ha.iter().zip(&hb) {
             assert_eq!(ia, ib, "{variant}: Newton iterations differ");
             for (x, y) in fa.iter().zip(fb) {
-                assert!((x - y).abs() < 1e-8 * scale, "{variant}: force {x} vs {y}");
+                assert!((x - y).abs() < 1e-7 * scale, "{variant}: force {x} vs {y}");
             }
         }
         let (da, db) = (&a["final_draw_in"], &b["final_draw_in"]);
@@ -206,7 +210,7 @@ fn both_linear_solvers_give_the_same_cup() {
         assert!(size > 0.0, "{db}");
         for k in ["dx", "dy", "dd"] {
             let (x, y) = (number(da, k), number(db, k));
-            assert!((x - y).abs() < 1e-8 * size, "{variant}: draw-in {k} {x} vs {y}");
+            assert!((x - y).abs() < 1e-7 * size, "{variant}: draw-in {k} {x} vs {y}");
         }
         let _ = std::fs::remove_dir_all(&out_a);
         let _ = std::fs::remove_dir_all(&out_b);
