@@ -134,3 +134,16 @@ fn mu_at_and_charts_refuse_non_finite_values() {
     assert!(!dir.join("c.svg").exists() && !dir.join("c.csv").exists());
     let _ = PathBuf::new();
 }
+
+#[test]
+fn a_tool_path_far_beyond_the_body_is_refused() {
+    let src = SCENE.replace("[1, 0, 0, -0.05]", "[1, 1e308, 0, -0.05]")
+        + "sim.add_tool(roller, \"z+\");\n";
+    let (code, err) = run("reach", &src, &[]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("path of tool 'roller': its travel = 1e308 is more than 1e6 times the body's size")
+            && err.contains("reach.rhai:5:"),
+        "{err}"
+    );
+}

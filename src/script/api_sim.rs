@@ -122,6 +122,46 @@ fn warn_if_no_candidates(ctx: &NativeCallContext, s: &ScriptSim, t: &Tool, set: 
     }
 }
 
+/// A tool path that moves the tool (largest component) by more than [`REACH`] times the
+/// body's size is a unit or typing mistake (1e308 instead of 0.1): refused, since adaptive stepping would creep
+/// along it at the minimum step.
+fn check_reach(s: &ScriptSim, t: &Tool) -> ScriptResult<()> {
+    let st = s.borrow();
+    let Some(model) = st.model.as_ref() else {
+        return Ok(());
+    };
+    let nodes = &model.mesh.nodes;
+    let (lo, hi) = nodes.iter().fold(
+        (
+            crate::geometry::Vec3::repeat(f64::INFINITY),
+            crate::geometry::Vec3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    let size = (hi - lo).norm();
+    let points = t.schedule.points();
+    let Some(first) = points.first() else {
+        return Ok(());
+    };
+    let travel = points
+        .iter()
+        .map(|(_, u)| (u - first.1).amax())
+        .fold(0.0, f64::max);
+    if size.is_finite() && !(travel <= REACH * size) {
+        return fail(Error::input(
+            &format!("path of tool '{}': its travel", t.name),
+            format!("{travel:e}"),
+            &format!(
+                "is more than {REACH:e} times the body's size {size} (a unit or typing mistake?)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Largest tool travel, in body sizes.
+const REACH: f64 = 1e6;
+
 /// Shared handle: Rhai values are clones of it.
 pub type ScriptSim = Rc<RefCell<SimState>>;
 
@@ -739,6 +779,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         "add_tool",
         |ctx: NativeCallContext, s: &mut ScriptSim, t: Tool, set: &str| -> ScriptResult<()> {
             warn_if_no_candidates(&ctx, s, &t, set);
+            check_reach(s, &t)?;
             lift(s.borrow_mut().model_mut()?.add_tool(t, set, None))
         },
     );
@@ -752,6 +793,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
          -> ScriptResult<()> {
             let r = number(&r, "augmentation parameter r")?;
             warn_if_no_candidates(&ctx, s, &t, set);
+            check_reach(s, &t)?;
             lift(s.borrow_mut().model_mut()?.add_tool(t, set, Some(r)))
         },
     );
