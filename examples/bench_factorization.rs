@@ -19,8 +19,18 @@ use tribo::solver::system_dump;
 fn cpu_seconds() -> f64 {
     // utime + stime of this process, in clock ticks (100 per second on Linux).
     let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let fields: Vec<&str> = stat.rsplit(')').next().unwrap_or("").split_whitespace().collect();
-    let tick = |i: usize| fields.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    let fields: Vec<&str> = stat
+        .rsplit(')')
+        .next()
+        .unwrap_or("")
+        .split_whitespace()
+        .collect();
+    let tick = |i: usize| {
+        fields
+            .get(i)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
     (tick(11) + tick(12)) / 100.0
 }
 
@@ -37,7 +47,9 @@ fn time(repeats: usize, mut f: impl FnMut()) -> (f64, f64) {
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let path = args.next().expect("usage: bench_factorization SYSTEM_FILE [REPEATS]");
+    let path = args
+        .next()
+        .expect("usage: bench_factorization SYSTEM_FILE [REPEATS]");
     let repeats: usize = args.next().map_or(5, |s| s.parse().expect("REPEATS"));
     let (mut a, rhs, border) = system_dump::read(path.as_ref()).unwrap();
     if std::env::var_os("BENCH_NO_GROUPS").is_some() {
@@ -73,7 +85,10 @@ fn main() {
         solve(&mut sym);
     });
     let scale = x_lu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let diff = x_lu.iter().zip(&x_sym).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+    let diff = x_lu
+        .iter()
+        .zip(&x_sym)
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
     println!(
         "faer LU (partial pivoting, COLAMD): first call {first_lu:.1} ms, then {lu_wall:.1} ms wall / {lu_cpu:.1} ms CPU per factorization + solve"
     );
@@ -121,10 +136,10 @@ fn main() {
 /// off-diagonal entries -1 on the pattern of A + A^T and its degree + 1 on the diagonal.
 fn cholesky_floor(p: &SparsePattern, repeats: usize, grouped: bool) -> (f64, f64, usize) {
     use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::cholesky::llt::factor::LltRegularization;
     use faer::sparse::linalg::cholesky::{
         factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
     };
-    use faer::linalg::cholesky::llt::factor::LltRegularization;
     use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
     use faer::{Par, Side};
     let n = p.n;
@@ -156,16 +171,24 @@ fn cholesky_floor(p: &SparsePattern, repeats: usize, grouped: bool) -> (f64, f64
     }
     let sym = SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
     let order = match (&p.groups, grouped) {
-        (Some(groups), true) => Some(tribo::solver::symmetric_lu::grouped_order(&lower, groups).unwrap()),
+        (Some(groups), true) => {
+            Some(tribo::solver::symmetric_lu::grouped_order(&lower, groups).unwrap())
+        }
         _ => None,
     };
     let ordering = match &order {
-        Some((fwd, inv)) => SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, n)),
+        Some((fwd, inv)) => {
+            SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, n))
+        }
         None => SymmetricOrdering::Amd,
     };
-    let symbolic =
-        factorize_symbolic_cholesky(sym, Side::Lower, ordering, CholeskySymbolicParams::default())
-            .unwrap();
+    let symbolic = factorize_symbolic_cholesky(
+        sym,
+        Side::Lower,
+        ordering,
+        CholeskySymbolicParams::default(),
+    )
+    .unwrap();
     let mut l_values = vec![0.0; symbolic.len_val()];
     let mut buffer =
         MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));

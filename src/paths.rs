@@ -59,7 +59,11 @@ pub fn resolve_write(root: &Path, relative: &str, create_parents: bool) -> Resul
     let last = names.len() - 1;
     for (i, name) in names.into_iter().enumerate() {
         path.push(name);
-        let shown = path.strip_prefix(root).unwrap_or(&path).display().to_string();
+        let shown = path
+            .strip_prefix(root)
+            .unwrap_or(&path)
+            .display()
+            .to_string();
         match std::fs::symlink_metadata(&path) {
             Ok(m) if m.file_type().is_symlink() => {
                 return Err(refuse(&format!(

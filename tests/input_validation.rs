@@ -35,7 +35,10 @@ fn force_control_refuses_nan_and_infinity() {
         let src = format!("{SCENE}let t = roller.force_control([0, 0, -1], {given});\n");
         let (code, err) = run("fc", &src, &[]);
         assert_eq!(code, 1, "{given}: {err}");
-        assert!(err.contains(&format!("value = {shown} must be finite")), "{given}: {err}");
+        assert!(
+            err.contains(&format!("value = {shown} must be finite")),
+            "{given}: {err}"
+        );
         assert!(err.contains("fc.rhai:5:"), "{err}");
     }
 }
@@ -48,7 +51,8 @@ fn a_tool_with_no_candidate_nodes_warns() {
     let (code, err) = run("empty", &src, &[]);
     assert_eq!(code, 0, "{err}");
     assert!(
-        err.contains("warning: ") && err.contains("empty.rhai:7:")
+        err.contains("warning: ")
+            && err.contains("empty.rhai:7:")
             && err.contains("tool 'roller' has no candidate nodes (node set 'none' is empty)"),
         "{err}"
     );
@@ -75,25 +79,49 @@ fn a_folded_bezier_patch_is_refused() {
     let bow = "bezier_patch([[[0, 0, 0], [0, 1, 0]], [[1, 1, 0], [1, 0, 0]]])";
     let (code, err) = run("bow", &format!("let s = patch_surface([{bow}]);\n"), &[]);
     assert_eq!(code, 1);
-    assert!(err.contains("patch 0 folds over itself") && err.contains("bow.rhai:1:"), "{err}");
+    assert!(
+        err.contains("patch 0 folds over itself") && err.contains("bow.rhai:1:"),
+        "{err}"
+    );
     // The same patch with its corners in order is accepted.
     let ok = "bezier_patch([[[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0]]])";
-    assert_eq!(run("flat", &format!("let s = patch_surface([{ok}]);\n"), &[]).0, 0);
+    assert_eq!(
+        run("flat", &format!("let s = patch_surface([{ok}]);\n"), &[]).0,
+        0
+    );
 }
 
 #[test]
 fn counts_are_refused_with_the_given_value() {
     for (setting, msg) in [
-        ("increments: -3", "increments = -3 must be a whole number from 1 to"),
-        ("increments: 2.5", "increments = 2.5 must be a whole number from 1 to"),
-        ("increments: 0", "increments = 0 must be a whole number from 1 to"),
-        ("max_cutbacks: -1", "max_cutbacks = -1 must be a whole number >= 0"),
-        ("max_iterations: 2.5", "max_iterations = 2.5 must be a whole number >= 0"),
+        (
+            "increments: -3",
+            "increments = -3 must be a whole number from 1 to",
+        ),
+        (
+            "increments: 2.5",
+            "increments = 2.5 must be a whole number from 1 to",
+        ),
+        (
+            "increments: 0",
+            "increments = 0 must be a whole number from 1 to",
+        ),
+        (
+            "max_cutbacks: -1",
+            "max_cutbacks = -1 must be a whole number >= 0",
+        ),
+        (
+            "max_iterations: 2.5",
+            "max_iterations = 2.5 must be a whole number >= 0",
+        ),
     ] {
         let src = format!("{SCENE}sim.settings(#{{ {setting} }});\n");
         let (code, err) = run("counts", &src, &[]);
         assert_eq!(code, 1, "{setting}");
-        assert!(err.contains(msg) && err.contains("counts.rhai:5:"), "{setting}: {err}");
+        assert!(
+            err.contains(msg) && err.contains("counts.rhai:5:"),
+            "{setting}: {err}"
+        );
     }
 }
 
@@ -103,7 +131,12 @@ fn set_values_are_clear_and_integers_fill_float_declarations() {
     for bad in ["nan", "inf", "-inf", "NaN"] {
         let (code, err) = run("setnan", src, &["--set", &format!("mu={bad}")]);
         assert_eq!(code, 1);
-        assert!(err.contains(&format!("--set mu={bad}: the value must be a finite number")), "{err}");
+        assert!(
+            err.contains(&format!(
+                "--set mu={bad}: the value must be a finite number"
+            )),
+            "{err}"
+        );
     }
     // An integer for a float declaration is a float: ceil() of it works.
     let src = "let travel = 40.0;\nlet step = 2.5;\nlet n = (travel / step).ceiling();\nassert(n == 10.0, `${n}`);\n";
@@ -116,20 +149,39 @@ fn set_values_are_clear_and_integers_fill_float_declarations() {
 
 #[test]
 fn restart_without_a_simulation_is_an_error() {
-    let (code, err) = run("norestart", "let a = 1;\n", &["--restart", "/nonexistent/ck.json"]);
+    let (code, err) = run(
+        "norestart",
+        "let a = 1;\n",
+        &["--restart", "/nonexistent/ck.json"],
+    );
     assert_eq!(code, 1);
-    assert!(err.contains("started no simulation, so the checkpoint was not used"), "{err}");
+    assert!(
+        err.contains("started no simulation, so the checkpoint was not used"),
+        "{err}"
+    );
 }
 
 #[test]
 fn mu_at_and_charts_refuse_non_finite_values() {
-    let (code, err) = run("muat", "let law = coulomb(0.2);\nlaw.mu_at(0.0/0.0);\n", &[]);
+    let (code, err) = run(
+        "muat",
+        "let law = coulomb(0.2);\nlaw.mu_at(0.0/0.0);\n",
+        &[],
+    );
     assert_eq!(code, 1);
-    assert!(err.contains("mu_at theta = NaN must be finite") && err.contains("muat.rhai:2:"), "{err}");
-    let chart = "line_chart(\"c.svg\", #{ series: [#{ name: \"a\", x: [0.0, 1.0], y: [0.0, 1e308] }] });\n";
+    assert!(
+        err.contains("mu_at theta = NaN must be finite") && err.contains("muat.rhai:2:"),
+        "{err}"
+    );
+    let chart =
+        "line_chart(\"c.svg\", #{ series: [#{ name: \"a\", x: [0.0, 1.0], y: [0.0, 1e308] }] });\n";
     let (code, err) = run("chart", chart, &[]);
     assert_eq!(code, 1);
-    assert!(err.contains("series[0].y[1] = 100000000000000000000") || err.contains("series[0].y[1] = 1e308"), "{err}");
+    assert!(
+        err.contains("series[0].y[1] = 100000000000000000000")
+            || err.contains("series[0].y[1] = 1e308"),
+        "{err}"
+    );
     let dir = std::env::temp_dir().join(format!("tribo-item11-{}-chart/out", std::process::id()));
     assert!(!dir.join("c.svg").exists() && !dir.join("c.csv").exists());
     let _ = PathBuf::new();
@@ -142,8 +194,9 @@ fn a_tool_path_far_beyond_the_body_is_refused() {
     let (code, err) = run("reach", &src, &[]);
     assert_eq!(code, 1);
     assert!(
-        err.contains("path of tool 'roller': its travel = 1e308 is more than 1e6 times the body's size")
-            && err.contains("reach.rhai:5:"),
+        err.contains(
+            "path of tool 'roller': its travel = 1e308 is more than 1e6 times the body's size"
+        ) && err.contains("reach.rhai:5:"),
         "{err}"
     );
 }

@@ -115,9 +115,15 @@ fn campaign_sample_of_shipped_script_mutants() {
             pool.push((s.clone(), what, text));
         }
     }
-    assert!(pool.len() > 3000, "the campaign has {} mutants to choose from", pool.len());
+    assert!(
+        pool.len() > 3000,
+        "the campaign has {} mutants to choose from",
+        pool.len()
+    );
     let mut rng = mutate::XorShift(0x5EED_0016);
-    let sample: Vec<_> = (0..SAMPLE).map(|_| pool.swap_remove(rng.below(pool.len()))).collect();
+    let sample: Vec<_> = (0..SAMPLE)
+        .map(|_| pool.swap_remove(rng.below(pool.len())))
+        .collect();
     let queue = std::sync::Arc::new(std::sync::Mutex::new(sample));
     let tally = std::sync::Arc::new(std::sync::Mutex::new(mutate::Tally::default()));
     let base = std::env::temp_dir().join(format!("tribo-mutants-{}", std::process::id()));
@@ -161,7 +167,11 @@ fn campaign_sample_of_shipped_script_mutants() {
     assert!(t.panics.is_empty(), "panics: {:#?}", t.panics);
     assert!(t.hangs.is_empty(), "hangs: {:#?}", t.hangs);
     assert!(t.signals.is_empty(), "signals: {:#?}", t.signals);
-    assert!(t.unlocated.is_empty(), "errors naming neither place nor value: {:#?}", t.unlocated);
+    assert!(
+        t.unlocated.is_empty(),
+        "errors naming neither place nor value: {:#?}",
+        t.unlocated
+    );
     assert!(t.ran > 0 && t.refused > 0, "both outcomes exercised");
 }
 

@@ -14,7 +14,14 @@ fn tribo(out: &Path) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_tribo"));
     c.arg("run")
         .arg(root().join("scripts/cylinder_drag.rhai"))
-        .args(["--quiet", "--set", "cells=24", "--set", "increments=12", "--out"])
+        .args([
+            "--quiet",
+            "--set",
+            "cells=24",
+            "--set",
+            "increments=12",
+            "--out",
+        ])
         .arg(out)
         .stdout(Stdio::null())
         .stderr(Stdio::piped());
@@ -25,7 +32,11 @@ fn wait_for(path: &Path) {
     let start = Instant::now();
     // The holder writes its pid right after taking the lock.
     while std::fs::read_to_string(path).map_or(true, |t| t.trim().is_empty()) {
-        assert!(start.elapsed() < Duration::from_secs(60), "{} never appeared", path.display());
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "{} never appeared",
+            path.display()
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
 }
@@ -47,8 +58,15 @@ fn a_second_run_into_a_busy_folder_is_refused() {
         "{err}"
     );
     let first = first.wait_with_output().unwrap();
-    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
-    assert!(!shared.join(".tribo.lock").exists(), "lock released at the end");
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    assert!(
+        !shared.join(".tribo.lock").exists(),
+        "lock released at the end"
+    );
 
     let lone = tribo(&alone).output().unwrap();
     assert!(lone.status.success());

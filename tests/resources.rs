@@ -72,7 +72,8 @@ fn run(tag: &str, source: &str, extra: &[&str]) -> Outcome {
 #[test]
 fn a_mesh_over_the_memory_limit_is_refused_before_allocation() {
     // 4001 x 1001 x 2 nodes: ~8 M nodes, hundreds of GB by the estimate.
-    let src = "let cells = 4000;\nlet mesh = block([0, 0, 0], [16, 4, 1], [cells, cells / 4, 1]);\n\
+    let src =
+        "let cells = 4000;\nlet mesh = block([0, 0, 0], [16, 4, 1], [cells, cells / 4, 1]);\n\
                let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n";
     let o = run("mesh", src, &[]);
     assert_eq!(o.code, 1, "{}", o.stderr);
@@ -90,17 +91,23 @@ fn a_mesh_over_the_memory_limit_is_refused_before_allocation() {
     let small = "let mesh = block([0, 0, 0], [1, 1, 1], [30, 30, 30]);\n";
     assert_eq!(run("mesh-ok", small, &[]).code, 0);
     let o = run("mesh-low", small, &["--max-memory-mb", "100"]);
-    assert!(o.stderr.contains("over the memory limit of 100 MiB"), "{}", o.stderr);
+    assert!(
+        o.stderr.contains("over the memory limit of 100 MiB"),
+        "{}",
+        o.stderr
+    );
 }
 
 #[test]
 fn script_memory_is_bounded() {
     // 60 nested calls each holding a 4 Mi-element array (~4 GB if unbounded).
-    let src = "fn f(n) { let a = []; a.pad(4000000, 1.0); if n > 0 { f(n - 1) } else { 0 } }\nf(60);\n";
+    let src =
+        "fn f(n) { let a = []; a.pad(4000000, 1.0); if n > 0 { f(n - 1) } else { 0 } }\nf(60);\n";
     let o = run("recursion", src, &["--max-memory-mb", "400"]);
     assert_eq!(o.code, 1);
     assert!(
-        o.stderr.contains("over the limit of 400 MiB (raise it with --max-memory-mb)"),
+        o.stderr
+            .contains("over the limit of 400 MiB (raise it with --max-memory-mb)"),
         "{}",
         o.stderr
     );
@@ -112,16 +119,25 @@ fn script_memory_is_bounded() {
 fn endless_loops_stop_with_the_limit_message() {
     let o = run("loop", "let i = 0;\nloop { i += 1; }\n", &[]);
     assert_eq!(o.code, 1);
-    assert!(o.stderr.contains("s.rhai:2:") && o.stderr.contains("Too many operations"), "{}", o.stderr);
+    assert!(
+        o.stderr.contains("s.rhai:2:") && o.stderr.contains("Too many operations"),
+        "{}",
+        o.stderr
+    );
     assert!(o.wall < Duration::from_secs(60), "{:?}", o.wall);
 
     // Each push re-measures the array (quadratic): the operation count alone would take
     // hours; the script-time limit stops it.
-    let o = run("push", "let a = [];\nloop { a.push(1); }\n", &["--max-script-seconds", "2"]);
+    let o = run(
+        "push",
+        "let a = [];\nloop { a.push(1); }\n",
+        &["--max-script-seconds", "2"],
+    );
     assert_eq!(o.code, 1);
     assert!(
         o.stderr.contains("s.rhai:2:")
-            && o.stderr.contains("over the limit of 2 s (raise it with --max-script-seconds)"),
+            && o.stderr
+                .contains("over the limit of 2 s (raise it with --max-script-seconds)"),
         "{}",
         o.stderr
     );
@@ -139,10 +155,15 @@ sim.fix("z-", "xyz");
 
 #[test]
 fn increments_and_paths_are_bounded() {
-    let o = run("1e12", &format!("{SCENE}sim.settings(#{{ increments: 1e12 }});\n"), &[]);
+    let o = run(
+        "1e12",
+        &format!("{SCENE}sim.settings(#{{ increments: 1e12 }});\n"),
+        &[],
+    );
     assert_eq!(o.code, 1);
     assert!(
-        o.stderr.contains("increments = 1000000000000 must be a whole number from 1 to 100000"),
+        o.stderr
+            .contains("increments = 1000000000000 must be a whole number from 1 to 100000"),
         "{}",
         o.stderr
     );
@@ -154,13 +175,18 @@ fn increments_and_paths_are_bounded() {
     let o = run("1e308", &src, &["--max-increments", "20"]);
     assert_eq!(o.code, 1, "{}", o.stderr);
     assert!(
-        o.stderr.contains("path of tool 'roller': its travel = 1e308 is more than"),
+        o.stderr
+            .contains("path of tool 'roller': its travel = 1e308 is more than"),
         "{}",
         o.stderr
     );
     assert!(o.wall < Duration::from_secs(60), "{:?}", o.wall);
     let out = std::env::temp_dir().join(format!("tribo-res-{}-1e308/out", std::process::id()));
-    assert!(folder_bytes(&out) < 1 << 20, "{} bytes written", folder_bytes(&out));
+    assert!(
+        folder_bytes(&out) < 1 << 20,
+        "{} bytes written",
+        folder_bytes(&out)
+    );
 
     // A run that would go on: stopped by the increments cap with its message.
     let src = format!("{SCENE}sim.settings(#{{ increments: 50 }});\nsim.run();\n");
@@ -168,12 +194,22 @@ fn increments_and_paths_are_bounded() {
     assert_eq!(o.code, 0, "{}", o.stderr);
     let src = format!("{SCENE}sim.settings(#{{ increments: 50 }});\nsim.run();\n");
     let o = run("cap-low", &src, &["--max-increments", "10"]);
-    assert!(o.stderr.contains("increments = 50 must be a whole number from 1 to 10"), "{}", o.stderr);
+    assert!(
+        o.stderr
+            .contains("increments = 50 must be a whole number from 1 to 10"),
+        "{}",
+        o.stderr
+    );
     let src = format!(
         "{SCENE}sim.settings(#{{ increments: 5, step_control: \"adaptive\", dt_max: 0.01, dt_initial: 0.01 }});\nsim.run();\n"
     );
     let o = run("cap-run", &src, &["--max-increments", "10"]);
-    assert!(o.stderr.contains("taken 10 increments, the limit (raise it with --max-increments)"), "{}", o.stderr);
+    assert!(
+        o.stderr
+            .contains("taken 10 increments, the limit (raise it with --max-increments)"),
+        "{}",
+        o.stderr
+    );
 }
 
 fn folder_bytes(dir: &std::path::Path) -> u64 {
@@ -200,7 +236,8 @@ fn output_size_is_capped() {
     let o = run("disk", src, &["--max-output-mb", "8"]);
     assert_eq!(o.code, 1);
     assert!(
-        o.stderr.contains("over the limit of 8388608 bytes (raise it with --max-output-mb)")
+        o.stderr
+            .contains("over the limit of 8388608 bytes (raise it with --max-output-mb)")
             && o.stderr.contains("s.rhai:3:"),
         "{}",
         o.stderr
@@ -211,5 +248,8 @@ fn output_size_is_capped() {
         .map(|e| e.unwrap().metadata().unwrap().len())
         .sum();
     // At most one file (512 KiB) over the cap.
-    assert!(written <= (8 << 20) + (512 << 10), "{written} bytes written");
+    assert!(
+        written <= (8 << 20) + (512 << 10),
+        "{written} bytes written"
+    );
 }

@@ -71,7 +71,11 @@ impl Tree {
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
             .collect();
-        assert_eq!(names, vec!["marker.txt".to_string()], "files appeared outside");
+        assert_eq!(
+            names,
+            vec!["marker.txt".to_string()],
+            "files appeared outside"
+        );
         assert_eq!(
             std::fs::read_to_string(self.outside().join("marker.txt")).unwrap(),
             "untouched"
@@ -100,7 +104,11 @@ sim.run();
 fn write_text_refuses_links_dots_and_absolute_paths() {
     let t = Tree::new("write");
     symlink(t.outside(), t.out().join("link")).unwrap();
-    symlink(t.outside().join("marker.txt"), t.out().join("file_link.txt")).unwrap();
+    symlink(
+        t.outside().join("marker.txt"),
+        t.out().join("file_link.txt"),
+    )
+    .unwrap();
     let absolute = t.outside().join("abs.txt");
     let cases = [
         ("link/x.txt".to_string(), "symbolic link 'link'"),
@@ -121,7 +129,10 @@ fn write_text_refuses_links_dots_and_absolute_paths() {
     // Positive control: a plain relative path is written below the output folder.
     let (code, _, err) = t.run("write_text(\"notes/a.txt\", \"ok\");", &[]);
     assert_eq!(code, 0, "{err}");
-    assert_eq!(std::fs::read_to_string(t.out().join("notes/a.txt")).unwrap(), "ok");
+    assert_eq!(
+        std::fs::read_to_string(t.out().join("notes/a.txt")).unwrap(),
+        "ok"
+    );
 }
 
 #[test]
@@ -131,7 +142,10 @@ fn run_outputs_refuse_linked_history_and_frames() {
     symlink(t.outside().join("marker.txt"), t.out().join("history.csv")).unwrap();
     let (code, _, err) = t.run(RUN, &[]);
     assert_ne!(code, 0);
-    assert!(err.contains("\"history.csv\"") && err.contains("symbolic link"), "{err}");
+    assert!(
+        err.contains("\"history.csv\"") && err.contains("symbolic link"),
+        "{err}"
+    );
     t.assert_outside_untouched();
 
     // frames/ linked to a folder outside.
@@ -145,7 +159,10 @@ fn run_outputs_refuse_linked_history_and_frames() {
     // checkpoints/ linked to a folder outside.
     let t = Tree::new("checkpoints");
     symlink(t.outside(), t.out().join("checkpoints")).unwrap();
-    let (code, _, err) = t.run(&format!("{RUN}\nsim.checkpoint(\"checkpoints/c.json\");"), &[]);
+    let (code, _, err) = t.run(
+        &format!("{RUN}\nsim.checkpoint(\"checkpoints/c.json\");"),
+        &[],
+    );
     assert_ne!(code, 0);
     assert!(err.contains("symbolic link 'checkpoints'"), "{err}");
     t.assert_outside_untouched();
@@ -168,7 +185,11 @@ fn imports_outside_the_allowed_folders_are_refused() {
     )
     .unwrap();
     let abs = t.outside().join("evil");
-    symlink(t.outside().join("evil.rhai"), t.script_dir().join("linked.rhai")).unwrap();
+    symlink(
+        t.outside().join("evil.rhai"),
+        t.script_dir().join("linked.rhai"),
+    )
+    .unwrap();
     for import in [
         "../outside/evil".to_string(),
         abs.display().to_string(),
@@ -186,7 +207,10 @@ fn imports_outside_the_allowed_folders_are_refused() {
     // The same import is allowed once its folder is named on the command line.
     let outside = t.outside().display().to_string();
     let (code, out, err) = t.run(
-        &format!("import {:?} as m;\nprint(m::f());", abs.display().to_string()),
+        &format!(
+            "import {:?} as m;\nprint(m::f());",
+            abs.display().to_string()
+        ),
         &["--allow-read", &outside],
     );
     assert_eq!(code, 0, "{err}");
@@ -196,7 +220,11 @@ fn imports_outside_the_allowed_folders_are_refused() {
     let (code, out, err) = t.run("import \"good\" as m;\nprint(m::g());", &[]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains('7'));
-    std::fs::write(t.script_dir().join("cycle.rhai"), "import \"cycle\" as c;\n").unwrap();
+    std::fs::write(
+        t.script_dir().join("cycle.rhai"),
+        "import \"cycle\" as c;\n",
+    )
+    .unwrap();
     let (code, _, err) = t.run("import \"cycle\" as m;", &[]);
     assert_ne!(code, 0);
     assert!(err.contains("import cycle"), "{err}");
@@ -205,14 +233,21 @@ fn imports_outside_the_allowed_folders_are_refused() {
 #[test]
 fn json_reads_outside_do_not_reveal_what_exists() {
     let t = Tree::new("json");
-    std::fs::write(t.outside().join("secret.json"), "{\"patches\": \"TOP-SECRET\"}").unwrap();
+    std::fs::write(
+        t.outside().join("secret.json"),
+        "{\"patches\": \"TOP-SECRET\"}",
+    )
+    .unwrap();
     let existing = t.outside().join("secret.json").display().to_string();
     let missing = t.outside().join("nothing-here.json").display().to_string();
     let message = |path: &str| {
         let (code, _, err) = t.run(&format!("bezier_surface_json({path:?});"), &[]);
         assert_ne!(code, 0, "{path}: accepted");
         assert!(!err.contains("TOP-SECRET"), "contents echoed: {err}");
-        assert!(err.contains("outside the folders scripts may read"), "{path}: {err}");
+        assert!(
+            err.contains("outside the folders scripts may read"),
+            "{path}: {err}"
+        );
         err.replace(path, "PATH")
     };
     // The same message whether or not the outside file exists.
@@ -220,7 +255,11 @@ fn json_reads_outside_do_not_reveal_what_exists() {
     assert_eq!(message("/etc/passwd"), message("/etc/no-such-file"));
     message("../outside/secret.json");
     // A link in the script's folder pointing outside is refused too.
-    symlink(t.outside().join("secret.json"), t.script_dir().join("link.json")).unwrap();
+    symlink(
+        t.outside().join("secret.json"),
+        t.script_dir().join("link.json"),
+    )
+    .unwrap();
     message("link.json");
 }
 
@@ -245,7 +284,10 @@ fn fifo_and_device_inputs_are_refused_without_reading() {
     // /dev/zero: outside by default; with /dev allowed, still not a regular file.
     let (code, _, err) = t.run("bezier_surface_json(\"/dev/zero\");", &[]);
     assert_ne!(code, 0);
-    assert!(err.contains("outside the folders scripts may read"), "{err}");
+    assert!(
+        err.contains("outside the folders scripts may read"),
+        "{err}"
+    );
     let (code, _, err) = t.run(
         "bezier_surface_json(\"/dev/zero\");",
         &["--allow-read", "/dev"],
@@ -259,8 +301,14 @@ fn files_over_the_read_cap_are_refused() {
     let t = Tree::new("cap");
     let big = format!("{{\"patches\": [], \"pad\": \"{}\"}}", "x".repeat(2 << 20));
     std::fs::write(t.script_dir().join("big.json"), big).unwrap();
-    let (code, _, err) = t.run("bezier_surface_json(\"big.json\");", &["--max-read-mb", "1"]);
+    let (code, _, err) = t.run(
+        "bezier_surface_json(\"big.json\");",
+        &["--max-read-mb", "1"],
+    );
     assert_ne!(code, 0);
-    assert!(err.contains("over the read limit of 1048576 bytes"), "{err}");
+    assert!(
+        err.contains("over the read limit of 1048576 bytes"),
+        "{err}"
+    );
     assert!(!err.contains("xxxx"), "contents echoed: {err}");
 }

@@ -21,12 +21,17 @@ fn every_scene_finishes_with_engine_defaults() {
     for path in &scripts {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
         let host = HostOptions {
-            out_dir: std::env::temp_dir().join(format!("tribo-scene-{}-{name}", std::process::id())),
+            out_dir: std::env::temp_dir()
+                .join(format!("tribo-scene-{}-{name}", std::process::id())),
             ..HostOptions::default()
         };
         if let Err(e) = script::run_file(path, &[], &host) {
             failures.push(format!("{name}: {e}"));
         }
     }
-    assert!(failures.is_empty(), "failed scenes:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "failed scenes:\n{}",
+        failures.join("\n")
+    );
 }

@@ -102,7 +102,10 @@ fn run_cup_with(out: &Path, sets: &[&str]) -> Value {
     for s in sets {
         cmd.args(["--set", s]);
     }
-    assert!(cmd.status().expect("tribo runs").success(), "square cup {sets:?} failed");
+    assert!(
+        cmd.status().expect("tribo runs").success(),
+        "square cup {sets:?} failed"
+    );
     let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
     serde_json::from_str(&text).expect("summary.json is JSON")
 }
@@ -137,7 +140,10 @@ fn defaults_converge_in_few_iterations_and_keep_the_answer() {
         .iter()
         .map(|v| v.as_f64().unwrap())
         .collect();
-    assert!(orders.len() >= 25, "an order in most increments: {orders:?}");
+    assert!(
+        orders.len() >= 25,
+        "an order in most increments: {orders:?}"
+    );
     for (i, p) in orders.iter().enumerate().skip(6) {
         assert!(*p >= 1.8, "increment {}: observed order {p}", i + 1);
     }
@@ -193,12 +199,18 @@ fn history(out: &Path) -> Vec<(usize, Vec<f64>)> {
 #[test]
 fn both_linear_solvers_give_the_same_cup() {
     for variant in ["paper", "benchmark"] {
-        let (out_a, out_b) = (out_dir(&format!("{variant}_sym")), out_dir(&format!("{variant}_lu")));
+        let (out_a, out_b) = (
+            out_dir(&format!("{variant}_sym")),
+            out_dir(&format!("{variant}_lu")),
+        );
         let a = run_cup_solver(variant, "symmetric_lu", &out_a);
         let b = run_cup_solver(variant, "lu", &out_b);
         let (ha, hb) = (history(&out_a), history(&out_b));
         assert_eq!(ha.len(), hb.len());
-        let scale = hb.iter().flat_map(|(_, f)| f).fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = hb
+            .iter()
+            .flat_map(|(_, f)| f)
+            .fold(0.0f64, |m, v| m.max(v.abs()));
         for ((ia, fa), (ib, fb)) in ha.iter().zip(&hb) {
             assert_eq!(ia, ib, "{variant}: Newton iterations differ");
             for (x, y) in fa.iter().zip(fb) {
@@ -206,11 +218,16 @@ fn both_linear_solvers_give_the_same_cup() {
             }
         }
         let (da, db) = (&a["final_draw_in"], &b["final_draw_in"]);
-        let size = ["dx", "dy", "dd"].iter().fold(0.0f64, |m, k| m.max(number(db, k).abs()));
+        let size = ["dx", "dy", "dd"]
+            .iter()
+            .fold(0.0f64, |m, k| m.max(number(db, k).abs()));
         assert!(size > 0.0, "{db}");
         for k in ["dx", "dy", "dd"] {
             let (x, y) = (number(da, k), number(db, k));
-            assert!((x - y).abs() < 1e-7 * size, "{variant}: draw-in {k} {x} vs {y}");
+            assert!(
+                (x - y).abs() < 1e-7 * size,
+                "{variant}: draw-in {k} {x} vs {y}"
+            );
         }
         let _ = std::fs::remove_dir_all(&out_a);
         let _ = std::fs::remove_dir_all(&out_b);

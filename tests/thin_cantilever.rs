@@ -58,7 +58,9 @@ fn elastica(alpha: f64) -> f64 {
             let k2 = rhs(add(y, k1, h / 2.0));
             let k3 = rhs(add(y, k2, h / 2.0));
             let k4 = rhs(add(y, k3, h));
-            y = std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+            y = std::array::from_fn(|i| {
+                y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
         }
         y
     };
@@ -109,7 +111,10 @@ fn residuals(r: &IncrementReport) -> Vec<f64> {
 }
 
 fn sci(v: &[f64]) -> String {
-    v.iter().map(|x| format!("{x:.2e}")).collect::<Vec<_>>().join(" ")
+    v.iter()
+        .map(|x| format!("{x:.2e}"))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// The small-strain tip deflection of `cells` under `force` (linear: one solve).

@@ -38,7 +38,10 @@ fn main() {
     let limit = Duration::from_secs(arg("--timeout", 60));
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let bin = root.join("target/release/tribo");
-    assert!(bin.is_file(), "build the release binary first: cargo build --release");
+    assert!(
+        bin.is_file(),
+        "build the release binary first: cargo build --release"
+    );
 
     let scripts = shipped_scripts(&root);
     let mut pool: Vec<(PathBuf, String, String)> = Vec::new();

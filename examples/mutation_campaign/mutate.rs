@@ -76,7 +76,8 @@ fn sites(src: &str) -> Vec<(usize, usize, Kind)> {
                     || b[i] == b'_'
                     || (b[i] == b'.' && b.get(i + 1).is_some_and(|d| d.is_ascii_digit()))
                     || ((b[i] == b'e' || b[i] == b'E')
-                        && b.get(i + 1).is_some_and(|d| d.is_ascii_digit() || *d == b'-')))
+                        && b.get(i + 1)
+                            .is_some_and(|d| d.is_ascii_digit() || *d == b'-')))
             {
                 if (b[i] == b'e' || b[i] == b'E') && b[i + 1] == b'-' {
                     i += 1;
@@ -135,7 +136,9 @@ pub fn shrink(src: &str) -> Vec<String> {
 pub enum Verdict {
     Ran,
     /// Stopped with an error; `located` when it names file:line:column or a value.
-    Refused { located: bool },
+    Refused {
+        located: bool,
+    },
     Panic,
     Signal(i32),
     Hang,
@@ -216,7 +219,10 @@ fn located(stderr: &str) -> bool {
         return false;
     };
     let place = line.find(".rhai:").is_some_and(|at| {
-        line[at + 6..].chars().next().is_some_and(|c| c.is_ascii_digit())
+        line[at + 6..]
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_digit())
     });
     place || line.contains(" = ") || line.contains("--set ")
 }

@@ -403,7 +403,8 @@ impl BezierPatch {
             for j in 0..N {
                 let Some((c, uv)) = grid[i][j] else { continue };
                 for (a, b) in [(i + 1, j), (i, j + 1), (i + 2, j), (i, j + 2)] {
-                    if let Some(Some((d, _))) = grid.get(a).map(|row| row.get(b).copied().flatten()) {
+                    if let Some(Some((d, _))) = grid.get(a).map(|row| row.get(b).copied().flatten())
+                    {
                         if c.dot(&d) < 0.0 {
                             return Some(uv);
                         }

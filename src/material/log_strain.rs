@@ -359,7 +359,9 @@ mod tests {
     #[test]
     fn small_strain_under_rotation_keeps_its_relative_precision() {
         let w = Mat3::new(0.0, -1e-3, 0.4e-3, 1e-3, 0.0, -0.7e-3, -0.4e-3, 0.7e-3, 0.0);
-        let eps = Mat3::new(1e-7, 0.3e-7, 0.0, 0.3e-7, -0.5e-7, 0.2e-7, 0.0, 0.2e-7, 0.8e-7);
+        let eps = Mat3::new(
+            1e-7, 0.3e-7, 0.0, 0.3e-7, -0.5e-7, 0.2e-7, 0.0, 0.2e-7, 0.8e-7,
+        );
         // H = (I + W)(I + eps) - I with W skew: a rotation to first order.
         let h = w + eps + w * eps;
         let a = h + h.transpose() + h.transpose() * h;
@@ -368,7 +370,11 @@ mod tests {
         let new = LogStrain::from_displacement_gradient(&h).unwrap().strain();
         let old = LogStrain::new(&(Mat3::identity() + a)).unwrap().strain();
         let rel = |e: Voigt| (e - exact).amax() / exact.amax();
-        println!("relative strain error: from H {:e}, from C {:e}", rel(new), rel(old));
+        println!(
+            "relative strain error: from H {:e}, from C {:e}",
+            rel(new),
+            rel(old)
+        );
         assert!(rel(new) < 1e-12, "from H: {:e}", rel(new));
         // The test can tell: the rounded C loses six more digits.
         assert!(rel(old) > 1e-11, "from C: {:e}", rel(old));

@@ -123,7 +123,10 @@ impl FolderLock {
             write.map_err(|e| Error::io(&path, e))?;
             return Ok(FolderLock { _file: file, path });
         }
-        Err(Error::io(&path, "the lock file keeps changing; another run is starting"))
+        Err(Error::io(
+            &path,
+            "the lock file keeps changing; another run is starting",
+        ))
     }
 }
 
@@ -164,7 +167,10 @@ mod tests {
         let lock = FolderLock::acquire(&base).unwrap();
         let err = FolderLock::acquire(&base).unwrap_err().to_string();
         assert!(
-            err.contains(&format!("in use by another tribo run (process {}", std::process::id())),
+            err.contains(&format!(
+                "in use by another tribo run (process {}",
+                std::process::id()
+            )),
             "{err}"
         );
         drop(lock);
@@ -173,7 +179,9 @@ mod tests {
         std::fs::write(base.join(LOCK_FILE), "999999999\n").unwrap();
         let lock = FolderLock::acquire(&base).unwrap();
         assert_eq!(
-            std::fs::read_to_string(base.join(LOCK_FILE)).unwrap().trim(),
+            std::fs::read_to_string(base.join(LOCK_FILE))
+                .unwrap()
+                .trim(),
             std::process::id().to_string()
         );
         drop(lock);

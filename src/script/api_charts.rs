@@ -95,7 +95,9 @@ fn line_chart_spec(spec: &Map) -> ScriptResult<LineChart> {
                 return fail(crate::Error::input(
                     &format!("series[{i}].{axis}[{j}]"),
                     v,
-                    &format!("must be finite and at most {CHART_LIMIT:e} in magnitude to be charted"),
+                    &format!(
+                        "must be finite and at most {CHART_LIMIT:e} in magnitude to be charted"
+                    ),
                 ));
             }
         }

@@ -128,9 +128,9 @@ fn parse_grading(spec: &Map) -> ScriptResult<[Grading; 3]> {
 /// over the run's limit.
 fn block_cells(cells: &Array, limits: &super::limits::Limits) -> ScriptResult<[usize; 3]> {
     let n = counts3(cells, "block cells")?;
-    let nodes = n
-        .iter()
-        .fold(1u64, |acc, &k| acc.saturating_mul((k as u64).saturating_add(1)));
+    let nodes = n.iter().fold(1u64, |acc, &k| {
+        acc.saturating_mul((k as u64).saturating_add(1))
+    });
     limits.check_mesh(nodes).or_else(runtime_error)?;
     Ok(n)
 }

@@ -1118,9 +1118,11 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         move |path: &str, text: &str| -> ScriptResult<String> {
             let folder = lift(crate::output::OutputFolder::create(&h.out_dir))?;
             let file = lift(folder.resolve_for_write(path))?;
-            lift(crate::paths::create_file(&file)
-                .and_then(|mut f| std::io::Write::write_all(&mut f, text.as_bytes()))
-                .map_err(|e| Error::io(&file, e)))?;
+            lift(
+                crate::paths::create_file(&file)
+                    .and_then(|mut f| std::io::Write::write_all(&mut f, text.as_bytes()))
+                    .map_err(|e| Error::io(&file, e)),
+            )?;
             Ok(file.display().to_string())
         },
     );

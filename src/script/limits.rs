@@ -75,7 +75,9 @@ impl Limits {
     /// Refuses a mesh of `nodes` nodes whose estimated memory is over the limit, before it
     /// is built.
     pub fn check_mesh(&self, nodes: u64) -> Result<(), String> {
-        let need = nodes.saturating_mul(BYTES_PER_NODE).saturating_add(BASE_BYTES);
+        let need = nodes
+            .saturating_mul(BYTES_PER_NODE)
+            .saturating_add(BASE_BYTES);
         if need > self.max_memory {
             return Err(format!(
                 "a mesh of {nodes} nodes needs about {} (estimated at {} KB per node), over the \

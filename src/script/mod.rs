@@ -102,9 +102,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     let mut host = host.clone();
     host.clock = Rc::default();
     let (limits, clock) = (host.limits.clone(), host.clock.clone());
-    engine.on_progress(move |ops| {
-        limits::progress_check(&limits, &clock, ops).map(Dynamic::from)
-    });
+    engine.on_progress(move |ops| limits::progress_check(&limits, &clock, ops).map(Dynamic::from));
     let host = Rc::new(host);
     api_scene::register(&mut engine, host.clone());
     api_tools::register(&mut engine, policy);
@@ -323,7 +321,10 @@ pub fn apply_overrides(
                 let declared = code
                     .split_once('=')
                     .map_or("", |(_, d)| d.trim().trim_end_matches(';').trim());
-                patched.push_str(&format!("let {name} = {};", literal(&as_declared(value, declared))));
+                patched.push_str(&format!(
+                    "let {name} = {};",
+                    literal(&as_declared(value, declared))
+                ));
                 seen[i] = true;
                 replaced = true;
                 break;

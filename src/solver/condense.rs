@@ -215,7 +215,9 @@ impl Condenser {
         let mut slots = Vec::new();
         let reduced = condenser.pattern.clone();
         condenser.walk(&zeros, &vec![0.0; full.n], &mut rhs, |r, c, _| {
-            let k = reduced.position(r, c).expect("the reduced pattern holds every contribution");
+            let k = reduced
+                .position(r, c)
+                .expect("the reduced pattern holds every contribution");
             slots.push(k as u32);
         });
         condenser.slots = slots;
@@ -292,8 +294,7 @@ impl Condenser {
                     *m_ab = f64::from(u8::from(alpha == beta)) - e_l;
                 }
             }
-            let rhs1: [f64; 3] =
-                std::array::from_fn(|b| -residual[ua + b] + r * residual[l + b]);
+            let rhs1: [f64; 3] = std::array::from_fn(|b| -residual[ua + b] + r * residual[l + b]);
             for alpha in 0..3 {
                 let ri = self.reduced_index[ua + alpha].expect("displacements stay");
                 rhs[ri] =

@@ -50,7 +50,11 @@ impl Simulation {
                 Ok(e) => {
                     let m = self.residual_record(&e, weights).1;
                     if m.is_finite() && m <= (1.0 - 1e-4 * alpha) * merit0 {
-                        let e = if e.has_jacobian() { e } else { ctx.evaluate(&xn, times)? };
+                        let e = if e.has_jacobian() {
+                            e
+                        } else {
+                            ctx.evaluate(&xn, times)?
+                        };
                         return Ok((xn, e, cut));
                     }
                     if cut == 0 && alpha0 == 1.0 && m.is_finite() && accept_full(&e)? {
@@ -66,7 +70,11 @@ impl Simulation {
         }
         match (best, last_err) {
             (Some((_, xn, e)), _) => {
-                let e = if e.has_jacobian() { e } else { ctx.evaluate(&xn, times)? };
+                let e = if e.has_jacobian() {
+                    e
+                } else {
+                    ctx.evaluate(&xn, times)?
+                };
                 Ok((xn, e, LINE_SEARCH_CUTS))
             }
             (None, Some(err)) => Err(err),
@@ -75,5 +83,4 @@ impl Simulation {
             )),
         }
     }
-
 }

@@ -475,7 +475,9 @@ impl<F: Factorization> BorderedSystem<F> {
             entries().filter_map(|(row, col)| Some((inner_index[row]?, inner_index[col]?))),
         );
         if let Some(groups) = &full.groups {
-            let inner_groups = (0..n).filter(|&d| inner_index[d].is_some()).map(|d| groups[d]);
+            let inner_groups = (0..n)
+                .filter(|&d| inner_index[d].is_some())
+                .map(|d| groups[d]);
             inner_pattern = inner_pattern.with_groups(inner_groups.collect());
         }
         let inner_pattern = Arc::new(inner_pattern);

@@ -19,8 +19,8 @@ pub mod step_control;
 pub mod symmetric_lu;
 pub mod system_dump;
 
-pub use model::{Model, SolverSettings};
 pub use energy::EnergyBalance;
+pub use model::{Model, SolverSettings};
 pub use newton::IterationRecord;
 pub use simulation::{IncrementReport, Simulation};
 pub use step_control::{AntiCycling, StepMode, StepSettings};

@@ -41,7 +41,11 @@ pub(super) struct Trial {
 
 impl Simulation {
     /// Solves J dx = -R, through the condensed system when multipliers are eliminated.
-    pub fn newton_step(&self, eval: &Evaluation, linear: &mut dyn LinearSolver) -> Result<Vec<f64>> {
+    pub fn newton_step(
+        &self,
+        eval: &Evaluation,
+        linear: &mut dyn LinearSolver,
+    ) -> Result<Vec<f64>> {
         // Tool offsets couple to every node of their tool: kept out of the sparse LU.
         let border: Vec<usize> = self.dofs.tool_offset.iter().flatten().copied().collect();
         match &self.condenser {
@@ -92,9 +96,12 @@ impl Simulation {
         Ok((norm(&next[..n_u]) <= 0.75 * norm(&dx[..n_u])).then_some(next))
     }
 
-
     /// Residual norms of an evaluation (the convergence measures and the merit function).
-    pub(super) fn residual_record(&self, eval: &Evaluation, weights: &[f64]) -> (IterationRecord, f64, f64) {
+    pub(super) fn residual_record(
+        &self,
+        eval: &Evaluation,
+        weights: &[f64],
+    ) -> (IterationRecord, f64, f64) {
         let settings = &self.model.settings;
         let n_u = 3 * self.dofs.n_nodes;
         let force = norm(&eval.residual[..n_u]);
@@ -129,7 +136,6 @@ impl Simulation {
             reference,
         )
     }
-
 
     /// Where the residual is largest: the three nodes with the largest force residual and
     /// the contact pair with the largest constraint residual.
@@ -166,7 +172,6 @@ impl Simulation {
         }
         text
     }
-
 
     pub(super) fn newton(&self, t_new: f64, linear: &mut dyn LinearSolver) -> Result<Trial> {
         let settings = self.model.settings.clone();
@@ -354,7 +359,6 @@ impl Simulation {
         })
     }
 
-
     pub(super) fn frozen_frames(&self, t_new: f64) -> Vec<Vec<Option<FrozenFrame>>> {
         self.model
             .contacts
@@ -381,7 +385,6 @@ impl Simulation {
             })
             .collect()
     }
-
 }
 
 fn norm(v: &[f64]) -> f64 {

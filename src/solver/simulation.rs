@@ -4,14 +4,14 @@
 //! leaves the last converged state untouched.
 
 use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
-use super::energy::{EnergyBalance, EnergyMemory};
-use super::newton::{IterationRecord, Trial};
 use super::checkpoint::SavedState;
 use super::condense::Condenser;
 use super::cycling::CyclingNode;
+use super::energy::{EnergyBalance, EnergyMemory};
 use super::force_control;
 use super::linear::{LinearSolver, Solver};
 use super::model::Model;
+use super::newton::{IterationRecord, Trial};
 use super::sparse::SparsePattern;
 use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
@@ -767,7 +767,12 @@ fn cycling_warning(
     let nodes: Vec<String> = cycling
         .iter()
         .take(SHOWN)
-        .map(|n| format!("{}:{} ({} flips)", model.contacts[n.tool].tool.name, n.node, n.flips))
+        .map(|n| {
+            format!(
+                "{}:{} ({} flips)",
+                model.contacts[n.tool].tool.name, n.node, n.flips
+            )
+        })
         .collect();
     let more = cycling.len().saturating_sub(SHOWN);
     format!(

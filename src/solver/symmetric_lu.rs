@@ -27,19 +27,19 @@
 
 use super::sparse::SparsePattern;
 use crate::{Error, Result};
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_unit_lower_triangular_in_place,
     solve_upper_triangular_in_place,
 };
+use faer::perm::PermRef;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering,
 };
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::perm::PermRef;
 use faer::sparse::linalg::{amd, SupernodalThreshold};
 use faer::sparse::SymbolicSparseColMatRef;
-use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, MatMut, MatRef, Par, Side};
 use std::sync::Arc;
 
@@ -282,8 +282,14 @@ pub fn grouped_order(lower: &SparsePattern, groups: &[usize]) -> Result<(Vec<usi
     let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(ng, graph.nnz()))
         .map_err(|e| Error::LinearSolver(format!("ordering workspace: {e:?}")))?;
     let g = SymbolicSparseColMatRef::new_checked(ng, ng, &graph.col_ptr, None, &graph.row_idx);
-    amd::order(&mut fwd, &mut inv, g, Default::default(), MemStack::new(&mut buffer))
-        .map_err(|e| Error::LinearSolver(format!("ordering failed: {e:?}")))?;
+    amd::order(
+        &mut fwd,
+        &mut inv,
+        g,
+        Default::default(),
+        MemStack::new(&mut buffer),
+    )
+    .map_err(|e| Error::LinearSolver(format!("ordering failed: {e:?}")))?;
     // Members of each group, ascending (counting sort by group).
     let mut start = vec![0usize; ng + 1];
     for &g in &compact {
@@ -359,7 +365,8 @@ impl NumericSymmetricLu {
                 let md = kd + rd;
                 let base = sy.offset[up.d];
                 let ld = MatRef::from_column_major_slice(&done[base..base + md * kd], md, kd);
-                let ud = MatRef::from_column_major_slice(&done[base + md * kd..][..rd * kd], rd, kd);
+                let ud =
+                    MatRef::from_column_major_slice(&done[base + md * kd..][..rd * kd], rd, kd);
                 let (nr, nc) = (rd - up.p1, up.p2 - up.p1);
                 // L: rows p1.. of d times U's columns p1..p2.
                 let l_rows = ld.subrows(kd + up.p1, nr);
@@ -422,7 +429,11 @@ impl NumericSymmetricLu {
                 );
                 // L_ss U_sR = A_sR, with U_sR^T stored.
                 let mut ut = MatMut::from_column_major_slice_mut(u_panel, r, k);
-                solve_unit_lower_triangular_in_place(diagonal.rb(), ut.rb_mut().transpose_mut(), Par::Seq);
+                solve_unit_lower_triangular_in_place(
+                    diagonal.rb(),
+                    ut.rb_mut().transpose_mut(),
+                    Par::Seq,
+                );
             }
         }
         Ok(())
@@ -446,7 +457,8 @@ impl NumericSymmetricLu {
         for s in 0..ns {
             let (f, k, r, rows) = sy.panels(s);
             let m = k + r;
-            let panel = MatRef::from_column_major_slice(&self.values[sy.offset[s]..][..m * k], m, k);
+            let panel =
+                MatRef::from_column_major_slice(&self.values[sy.offset[s]..][..m * k], m, k);
             let diagonal = panel.subrows(0, k);
             for c in 0..nrhs {
                 let xc = &mut x[c * n..(c + 1) * n];
@@ -467,7 +479,8 @@ impl NumericSymmetricLu {
         for s in (0..ns).rev() {
             let (f, k, r, rows) = sy.panels(s);
             let m = k + r;
-            let panel = MatRef::from_column_major_slice(&self.values[sy.offset[s]..][..m * k], m, k);
+            let panel =
+                MatRef::from_column_major_slice(&self.values[sy.offset[s]..][..m * k], m, k);
             let diagonal = panel.subrows(0, k);
             for c in 0..nrhs {
                 let xc = &mut x[c * n..(c + 1) * n];
@@ -490,7 +503,13 @@ impl NumericSymmetricLu {
 
 /// `out (rows x cols, column-major) = a b^T` for `a` (rows x k) and `b` (cols x k). Small
 /// products by plain loops (faer's dispatch costs more than a few hundred flops).
-fn dense_product(out: &mut Vec<f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>, rows: usize, cols: usize) {
+fn dense_product(
+    out: &mut Vec<f64>,
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    rows: usize,
+    cols: usize,
+) {
     out.clear();
     out.resize(rows * cols, 0.0);
     let k = a.ncols();
@@ -554,7 +573,10 @@ mod tests {
     struct Lcg(u64);
     impl Lcg {
         fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((self.0 >> 11) as f64) / ((1u64 << 53) as f64)
         }
     }
@@ -597,7 +619,11 @@ mod tests {
                 m[(a.pattern.row_idx[k], c)] = a.values[k];
             }
         }
-        m.lu().solve(&nalgebra::DVector::from_column_slice(b)).unwrap().as_slice().to_vec()
+        m.lu()
+            .solve(&nalgebra::DVector::from_column_slice(b))
+            .unwrap()
+            .as_slice()
+            .to_vec()
     }
 
     #[test]
@@ -635,10 +661,17 @@ mod tests {
         let b: Vec<f64> = (0..200).map(|i| (i as f64).cos()).collect();
         for border in [vec![], vec![17], vec![3, 150, 99]] {
             let (mut y, mut z) = (b.clone(), b.clone());
-            SymmetricLu::default().solve_bordered(&a, &mut y, &border).unwrap();
-            FaerLu::default().solve_bordered(&a, &mut z, &border).unwrap();
+            SymmetricLu::default()
+                .solve_bordered(&a, &mut y, &border)
+                .unwrap();
+            FaerLu::default()
+                .solve_bordered(&a, &mut z, &border)
+                .unwrap();
             for i in 0..200 {
-                assert!((y[i] - z[i]).abs() < 1e-12, "border {border:?}, unknown {i}");
+                assert!(
+                    (y[i] - z[i]).abs() < 1e-12,
+                    "border {border:?}, unknown {i}"
+                );
             }
         }
     }
@@ -647,7 +680,10 @@ mod tests {
     fn a_zero_pivot_falls_back_to_the_pivoting_lu() {
         // [[0, 1], [1, 1]]: regular, but its first pivot is 0 in any symmetric order that
         // puts unknown 0 first; and [[1, 1], [1, 0]] in the other order. Both are solved.
-        let p = Arc::new(SparsePattern::from_entries(2, [(0, 0), (1, 1), (0, 1), (1, 0)]));
+        let p = Arc::new(SparsePattern::from_entries(
+            2,
+            [(0, 0), (1, 1), (0, 1), (1, 0)],
+        ));
         for diagonal in [[0.0, 1.0], [1.0, 0.0]] {
             let mut a = SparseMatrix::zeros(p.clone());
             a.add(0, 0, diagonal[0]);
@@ -658,7 +694,10 @@ mod tests {
             let mut b = a.mul_vec(&x);
             let mut solver = SymmetricLu::default();
             solver.solve(&a, &mut b).unwrap();
-            assert!((b[0] - x[0]).abs() < 1e-14 && (b[1] - x[1]).abs() < 1e-14, "{b:?}");
+            assert!(
+                (b[0] - x[0]).abs() < 1e-14 && (b[1] - x[1]).abs() < 1e-14,
+                "{b:?}"
+            );
             // Either the zero pivot came first and was refused, or the order avoided it.
             assert!(solver.fallback_count <= 1);
         }
@@ -666,7 +705,14 @@ mod tests {
         let entries = [(0, 0), (1, 1), (2, 2), (0, 2), (2, 0), (1, 2), (2, 1)];
         let p = Arc::new(SparsePattern::from_entries(3, entries));
         let mut a = SparseMatrix::zeros(p);
-        for (r, c, v) in [(0, 0, 2.0), (1, 1, 3.0), (0, 2, 1.0), (2, 0, 1.0), (1, 2, 1.0), (2, 1, 1.0)] {
+        for (r, c, v) in [
+            (0, 0, 2.0),
+            (1, 1, 3.0),
+            (0, 2, 1.0),
+            (2, 0, 1.0),
+            (1, 2, 1.0),
+            (2, 1, 1.0),
+        ] {
             a.add(r, c, v);
         }
         let x = [1.0, -2.0, 0.5];
@@ -681,7 +727,10 @@ mod tests {
     fn a_tiny_pivot_is_refused_and_the_fallback_is_used() {
         // Unknown 0's pivot is 1e-14 against off-diagonal entries of 1: no pivoting would
         // amplify round-off by 1e14. The answer must still be right.
-        let p = Arc::new(SparsePattern::from_entries(2, [(0, 0), (1, 1), (0, 1), (1, 0)]));
+        let p = Arc::new(SparsePattern::from_entries(
+            2,
+            [(0, 0), (1, 1), (0, 1), (1, 0)],
+        ));
         let mut a = SparseMatrix::zeros(p);
         for (r, c, v) in [(0, 0, 1e-14), (1, 1, 1e-14), (0, 1, 1.0), (1, 0, 1.0)] {
             a.add(r, c, v);
@@ -691,12 +740,18 @@ mod tests {
         let mut solver = SymmetricLu::default();
         solver.solve(&a, &mut b).unwrap();
         assert_eq!(solver.fallback_count, 1);
-        assert!((b[0] - x[0]).abs() < 1e-14 && (b[1] - x[1]).abs() < 1e-14, "{b:?}");
+        assert!(
+            (b[0] - x[0]).abs() < 1e-14 && (b[1] - x[1]).abs() < 1e-14,
+            "{b:?}"
+        );
     }
 
     #[test]
     fn a_singular_matrix_is_an_error_not_a_panic() {
-        let p = Arc::new(SparsePattern::from_entries(2, [(0, 0), (1, 1), (0, 1), (1, 0)]));
+        let p = Arc::new(SparsePattern::from_entries(
+            2,
+            [(0, 0), (1, 1), (0, 1), (1, 0)],
+        ));
         let mut a = SparseMatrix::zeros(p);
         for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
             a.add(r, c, 1.0);

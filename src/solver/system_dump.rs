@@ -45,7 +45,9 @@ pub fn read(path: &Path) -> Result<(SparseMatrix, Vec<f64>, Vec<usize>)> {
     std::fs::File::open(path)
         .and_then(|mut f| f.read_to_end(&mut bytes))
         .map_err(|e| fail(e.to_string()))?;
-    let mut words = bytes.chunks_exact(8).map(|c| <[u8; 8]>::try_from(c).expect("8 bytes"));
+    let mut words = bytes
+        .chunks_exact(8)
+        .map(|c| <[u8; 8]>::try_from(c).expect("8 bytes"));
     let mut int = || -> Result<usize> {
         words
             .next()
@@ -56,7 +58,9 @@ pub fn read(path: &Path) -> Result<(SparseMatrix, Vec<f64>, Vec<usize>)> {
     if bytes.len() != 8 * (4 + n + 1 + 2 * nnz + n + n_border + has_groups * n) {
         return Err(fail("size does not match its header".into()));
     }
-    let mut words = bytes[32..].chunks_exact(8).map(|c| <[u8; 8]>::try_from(c).expect("8 bytes"));
+    let mut words = bytes[32..]
+        .chunks_exact(8)
+        .map(|c| <[u8; 8]>::try_from(c).expect("8 bytes"));
     let mut ints = |k: usize| -> Vec<usize> {
         (0..k)
             .map(|_| u64::from_le_bytes(words.next().expect("size checked")) as usize)
@@ -64,7 +68,10 @@ pub fn read(path: &Path) -> Result<(SparseMatrix, Vec<f64>, Vec<usize>)> {
     };
     let col_ptr = ints(n + 1);
     let row_idx = ints(nnz);
-    let floats: Vec<f64> = ints(nnz + n).into_iter().map(|b| f64::from_bits(b as u64)).collect();
+    let floats: Vec<f64> = ints(nnz + n)
+        .into_iter()
+        .map(|b| f64::from_bits(b as u64))
+        .collect();
     let border = ints(n_border);
     let groups = ints(has_groups * n);
     let mut pattern = SparsePattern {

@@ -159,7 +159,13 @@ pub fn first_newton_iterate(sim: &tribo::solver::Simulation, t: f64) -> Vec<f64>
 /// area `area` and element height `height` (Poisson ratio `nu`). Tests that read Newton's
 /// convergence order were written with it: with the smaller default Newton reaches
 /// round-off in too few iterations to measure an order; the Jacobian under test is the same.
-pub fn former_default_r(model: &mut tribo::solver::Model, c: usize, nu: f64, area: f64, height: f64) {
+pub fn former_default_r(
+    model: &mut tribo::solver::Model,
+    c: usize,
+    nu: f64,
+    area: f64,
+    height: f64,
+) {
     let p_wave_over_young = (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
     for r in &mut model.contacts[c].r {
         *r *= p_wave_over_young * area / (height * height);
