@@ -74,20 +74,34 @@ fn prefix(name: &str, e: Error) -> Error {
     }
 }
 
+/// What a wrong JSON value is, for an error message: its kind, and the value itself only
+/// for numbers and booleans. A table may come from a file, and error messages never echo a
+/// file's text (issue 16).
+fn kind(v: &Value) -> String {
+    match v {
+        Value::Null => "null".into(),
+        Value::Bool(b) => b.to_string(),
+        Value::Number(n) => n.to_string(),
+        Value::String(_) => "a string".into(),
+        Value::Array(a) => format!("an array of {} entries", a.len()),
+        Value::Object(_) => "an object".into(),
+    }
+}
+
 fn number(v: &Value, what: &str) -> Result<f64> {
     v.as_f64()
-        .ok_or_else(|| Error::input(what, v, "must be a number"))
+        .ok_or_else(|| Error::input(what, kind(v), "must be a number"))
 }
 
 fn array<'a>(v: &'a Value, what: &str) -> Result<&'a Vec<Value>> {
     v.as_array()
-        .ok_or_else(|| Error::input(what, v, "must be an array"))
+        .ok_or_else(|| Error::input(what, kind(v), "must be an array"))
 }
 
 fn point(v: &Value, what: &str) -> Result<Vec3> {
     let a = array(v, what)?;
     if a.len() != 3 {
-        return Err(Error::input(what, v, "must be [x, y, z]"));
+        return Err(Error::input(what, kind(v), "must be [x, y, z]"));
     }
     Ok(Vec3::new(
         number(&a[0], what)?,
@@ -151,7 +165,7 @@ pub fn patches_from_json(source: &str, text: &str) -> Result<(Vec<BezierPatch>, 
             Some(other) => {
                 return Err(fail(Error::input(
                     &format!("{name}.flip"),
-                    other,
+                    kind(other),
                     "must be true or false",
                 )))
             }
@@ -196,9 +210,12 @@ mod tests {
         let bad_point = GOOD.replace("[2,1,0.5]", "[2,\"a\",0.5]");
         let e = msg(&bad_point);
         assert!(
-            e.contains("t.json: patches[1].points[1][1] = \"a\" must be a number"),
+            e.contains("t.json: patches[1].points[1][1] = a string must be a number"),
             "{e}"
         );
+        let secret = GOOD.replace("[2,1,0.5]", "[2,\"root:x:0:0\",0.5]");
+        let e = msg(&secret);
+        assert!(!e.contains("root:x"), "a file's text is never echoed: {e}");
         let ragged = GOOD.replace("[[1,0,0],[1,1,0]]]", "[[1,0,0]]]");
         let e = msg(&ragged);
         assert!(
