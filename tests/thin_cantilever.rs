@@ -205,14 +205,10 @@ fn large_tip_force_reaches_the_elastica_in_five_increments() {
     let small = small_strain_tip(cells, 1.0) / beam_theory(1.0);
     let force = 100.0;
     let mut sim = cantilever(cells, force, StrainTheory::Finite, 5);
-    // The engine's extrapolating predictor (on by default since issue 14) continues the
-    // last increment's displacement change linearly; under a rotation of ~0.25 rad per
-    // increment that start stretches the fibres (membrane forces ~ (L/t)^2 times the
-    // bending ones) and increment 3 then needs more than 30 iterations. Measured with it
-    // on: 12, 15, fail; off: 12, 15, 9, 12, 9. A rotation-aware predictor is open work.
-    let mut settings = sim.model.settings.clone();
-    settings.extrapolate = false;
-    sim.change_settings(settings).unwrap();
+    // Engine defaults, extrapolating predictor included: continued linearly, a rotation
+    // of ~0.25 rad per increment stretches the fibres, and increment 3 failed from that
+    // start before the predictor was guarded by the merit of the unextrapolated start.
+    assert!(sim.model.settings.extrapolate);
     let mut increments = 0;
     while !sim.is_finished() {
         let report = sim.step().unwrap();

@@ -2,7 +2,7 @@
 //! merit function, the divergence guard, anti-cycling (freeze and release) and the linear
 //! solve of each iteration.
 
-use super::assembly::{Evaluation, FrozenFrame, PhaseTimes};
+use super::assembly::{Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
 use super::cycling::{CyclingMonitor, CyclingNode};
 use super::force_control;
 use super::linear::LinearSolver;
@@ -16,6 +16,9 @@ const DIVERGENCE_ITERATIONS: usize = 3;
 /// How many times a converged frozen state may be released and frozen again in one
 /// increment (see `cycling`); after that the free law alone decides.
 const MAX_RELEASES: usize = 3;
+/// How much larger than the unextrapolated start's merit the extrapolated start's may be
+/// before it is dropped (see `newton`).
+const EXTRAPOLATION_GUARD: f64 = 10.0;
 
 /// One Newton iteration's residual norms.
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
@@ -173,6 +176,26 @@ impl Simulation {
         text
     }
 
+    /// The Dirichlet predictor and the prescribed values of the increment applied to a
+    /// first iterate.
+    fn start_iterate(
+        &self,
+        ctx: &IncrementContext<'_>,
+        t_new: f64,
+        x: &mut [f64],
+        linear: &mut dyn LinearSolver,
+        times: &mut PhaseTimes,
+    ) -> Result<()> {
+        self.dirichlet_predictor(ctx, t_new, x, linear, times)?;
+        for bc in &self.model.dirichlet {
+            let v = bc.value.value(t_new);
+            for &node in &bc.nodes {
+                x[3 * node + bc.component] = v;
+            }
+        }
+        Ok(())
+    }
+
     pub(super) fn newton(&self, t_new: f64, linear: &mut dyn LinearSolver) -> Result<Trial> {
         let settings = self.model.settings.clone();
         let step = &settings.stepping;
@@ -210,21 +233,38 @@ impl Simulation {
         let mut monitor = CyclingMonitor::new(&sizes, step.anti_cycling, step.cycle_flips);
         let node_of = |c: usize, k: usize| self.model.contacts[c].candidates[k];
         let mut times = PhaseTimes::default();
+        let unextrapolated = (settings.extrapolate && self.last_step.is_some()).then(|| x.clone());
         if settings.extrapolate {
             self.extrapolate(t_new, &mut x);
         }
-        self.dirichlet_predictor(&ctx, t_new, &mut x, linear, &mut times)?;
-        for bc in &self.model.dirichlet {
-            let v = bc.value.value(t_new);
-            for &node in &bc.nodes {
-                x[3 * node + bc.component] = v;
+        self.start_iterate(&ctx, t_new, &mut x, linear, &mut times)?;
+        let mut eval = ctx.evaluate(&x, &mut times)?;
+        // The extrapolated start is a guess that the increment continues the last one's
+        // motion. Where it does not (a rotating thin beam: continued linearly, a rotation
+        // stretches the fibres, whose membrane stiffness is (L/t)^2 times the bending one),
+        // it can start Newton far outside its basin: on a cantilever turning 0.25 rad per
+        // increment the extrapolated start had 200 times the merit of the committed one and
+        // the increment failed. So a start whose merit exceeds the unextrapolated start's
+        // tenfold is dropped (one residual-only evaluation per increment; in forming the
+        // extrapolated start is the better one by far: a tool moved without the sheet
+        // penetrates it).
+        if let Some(mut plain) = unextrapolated {
+            self.start_iterate(&ctx, t_new, &mut plain, linear, &mut times)?;
+            let merit_of = |e: &Evaluation| self.residual_record(e, &weights).1;
+            let extrapolated = merit_of(&eval);
+            let committed = ctx
+                .evaluate_residual(&plain, &mut times)
+                .map(|e| merit_of(&e))
+                .unwrap_or(f64::INFINITY);
+            if !(extrapolated <= EXTRAPOLATION_GUARD * committed) && committed.is_finite() {
+                x = plain;
+                eval = ctx.evaluate(&x, &mut times)?;
             }
         }
         let mut residuals = Vec::new();
         let mut merits: Vec<f64> = Vec::new();
         let mut iterations = 0;
         let mut line_search_cuts = 0;
-        let mut eval = ctx.evaluate(&x, &mut times)?;
         // Merits before a freeze belong to another problem: divergence is judged after it.
         let mut window_start = 0;
         let mut releases = 0;
