@@ -4,23 +4,10 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+mod common;
+
 fn run_script(name: &str, source: &str, extra: &[&str]) -> (i32, String) {
-    let dir = std::env::temp_dir().join(format!("tribo-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{name}.rhai"));
-    std::fs::write(&path, source).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_tribo"))
-        .arg("run")
-        .arg(&path)
-        .arg("--quiet")
-        .arg("--out")
-        .arg(dir.join("out"))
-        .args(extra)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert!(!stderr.contains("panicked"), "{name}: panic: {stderr}");
-    (out.status.code().unwrap_or(-1), stderr)
+    common::run_script("cli", name, source, extra)
 }
 
 const SCENE: &str = r#"
@@ -95,7 +82,6 @@ fn missing_script_is_an_error() {
     assert_ne!(out.status.code(), Some(0));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("none.rhai"), "{err}");
-    let _ = PathBuf::new();
 }
 
 #[test]

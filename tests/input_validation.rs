@@ -1,26 +1,10 @@
 //! Issue 16, item 11: each bad input is refused with the value the user gave (or accepted and
 //! correct); never a silent wrong answer.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
 fn run(name: &str, source: &str, extra: &[&str]) -> (i32, String) {
-    let dir = std::env::temp_dir().join(format!("tribo-item11-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{name}.rhai"));
-    std::fs::write(&path, source).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_tribo"))
-        .arg("run")
-        .arg(&path)
-        .args(["--quiet", "--out"])
-        .arg(dir.join("out"))
-        .args(extra)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert!(!stderr.contains("panicked"), "{name}: {stderr}");
-    (out.status.code().unwrap_or(-1), stderr)
+    common::run_script("item11", name, source, extra)
 }
 
 const SCENE: &str = r#"
@@ -184,7 +168,6 @@ fn mu_at_and_charts_refuse_non_finite_values() {
     );
     let dir = std::env::temp_dir().join(format!("tribo-item11-{}-chart/out", std::process::id()));
     assert!(!dir.join("c.svg").exists() && !dir.join("c.csv").exists());
-    let _ = PathBuf::new();
 }
 
 #[test]

@@ -108,40 +108,6 @@ fn line_chart_spec(spec: &Map) -> ScriptResult<LineChart> {
 /// Largest magnitude a chart accepts.
 const CHART_LIMIT: f64 = 1e300;
 
-/// A Rhai value as JSON; `at` names the place in the value for errors.
-fn to_json(v: &Dynamic, at: &str) -> ScriptResult<serde_json::Value> {
-    use serde_json::Value;
-    if v.is_unit() {
-        Ok(Value::Null)
-    } else if let Ok(b) = v.as_bool() {
-        Ok(Value::Bool(b))
-    } else if let Ok(i) = v.as_int() {
-        Ok(Value::from(i))
-    } else if let Ok(f) = v.as_float() {
-        // JSON has no NaN or infinity: they become null, as in the engine's summary.
-        Ok(Value::from(f))
-    } else if v.is_string() || v.is_char() {
-        Ok(Value::String(v.to_string()))
-    } else if let Some(a) = v.clone().try_cast::<Array>() {
-        a.iter()
-            .enumerate()
-            .map(|(i, x)| to_json(x, &format!("{at}[{i}]")))
-            .collect::<ScriptResult<Vec<_>>>()
-            .map(Value::Array)
-    } else if let Some(m) = v.clone().try_cast::<Map>() {
-        let mut out = serde_json::Map::new();
-        for (k, x) in &m {
-            out.insert(k.to_string(), to_json(x, &format!("{at}.{k}"))?);
-        }
-        Ok(Value::Object(out))
-    } else {
-        runtime_error(format!(
-            "summary value {at} is a {} which has no JSON form (use numbers, strings, booleans, arrays, maps)",
-            v.type_name()
-        ))
-    }
-}
-
 pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     let h = host.clone();
     engine.register_fn(
@@ -214,7 +180,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             if key.is_empty() {
                 return runtime_error("a summary entry needs a non-empty name");
             }
-            let json = to_json(&value, key)?;
+            let json = to_json(&value, key, JsonUse::Summary)?;
             s.borrow_mut().add_summary_entry(key, json)
         },
     );

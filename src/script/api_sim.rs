@@ -902,7 +902,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             if name.is_empty() {
                 return runtime_error("sim.keep needs a non-empty name");
             }
-            let json = super::convert::keepable_json(&value, name)?;
+            let json = super::convert::to_json(&value, name, super::convert::JsonUse::Checkpoint)?;
             s.borrow_mut().keep(name, json);
             Ok(())
         },

@@ -67,10 +67,20 @@ pub fn counts3(a: &Array, what: &str) -> ScriptResult<[usize; 3]> {
     Ok(out)
 }
 
-/// A value `sim.keep` can store in a checkpoint, as JSON that [`from_json`] turns back into
-/// the same value: unit, booleans, integers, finite floats, strings, arrays and maps of
-/// them. `at` names the place in the value for errors (a NaN would come back as unit).
-pub fn keepable_json(v: &Dynamic, at: &str) -> ScriptResult<serde_json::Value> {
+/// What a script value is turned into JSON for; the two differ in what they do with a
+/// number JSON cannot hold and in how their errors read.
+#[derive(Clone, Copy)]
+pub enum JsonUse {
+    /// A run's summary: NaN and infinities become null, as in the engine's own summary.
+    Summary,
+    /// A checkpoint (`sim.keep`): [`from_json`] must give the same value back, so only
+    /// finite numbers (a NaN would come back as unit).
+    Checkpoint,
+}
+
+/// A Rhai value as JSON: unit, booleans, integers, floats, strings, arrays and maps of
+/// them. `at` names the place in the value for errors.
+pub fn to_json(v: &Dynamic, at: &str, purpose: JsonUse) -> ScriptResult<serde_json::Value> {
     use serde_json::Value;
     if v.is_unit() {
         Ok(Value::Null)
@@ -79,9 +89,10 @@ pub fn keepable_json(v: &Dynamic, at: &str) -> ScriptResult<serde_json::Value> {
     } else if let Ok(i) = v.as_int() {
         Ok(Value::from(i))
     } else if let Ok(f) = v.as_float() {
-        match serde_json::Number::from_f64(f) {
-            Some(n) => Ok(Value::Number(n)),
-            None => runtime_error(format!(
+        match (serde_json::Number::from_f64(f), purpose) {
+            (Some(n), _) => Ok(Value::Number(n)),
+            (None, JsonUse::Summary) => Ok(Value::Null),
+            (None, JsonUse::Checkpoint) => runtime_error(format!(
                 "sim.keep: {at} = {f} cannot be kept in a checkpoint (only finite numbers)"
             )),
         }
@@ -90,24 +101,31 @@ pub fn keepable_json(v: &Dynamic, at: &str) -> ScriptResult<serde_json::Value> {
     } else if let Some(a) = v.clone().try_cast::<Array>() {
         a.iter()
             .enumerate()
-            .map(|(i, x)| keepable_json(x, &format!("{at}[{i}]")))
+            .map(|(i, x)| to_json(x, &format!("{at}[{i}]"), purpose))
             .collect::<ScriptResult<Vec<_>>>()
             .map(Value::Array)
     } else if let Some(m) = v.clone().try_cast::<rhai::Map>() {
         let mut out = serde_json::Map::new();
         for (k, x) in &m {
-            out.insert(k.to_string(), keepable_json(x, &format!("{at}.{k}"))?);
+            out.insert(k.to_string(), to_json(x, &format!("{at}.{k}"), purpose)?);
         }
         Ok(Value::Object(out))
     } else {
-        runtime_error(format!(
-            "sim.keep: {at} is a {} which a checkpoint cannot hold (use numbers, strings, booleans, arrays, maps)",
-            v.type_name()
-        ))
+        let use_these = "(use numbers, strings, booleans, arrays, maps)";
+        runtime_error(match purpose {
+            JsonUse::Summary => format!(
+                "summary value {at} is a {} which has no JSON form {use_these}",
+                v.type_name()
+            ),
+            JsonUse::Checkpoint => format!(
+                "sim.keep: {at} is a {} which a checkpoint cannot hold {use_these}",
+                v.type_name()
+            ),
+        })
     }
 }
 
-/// The Rhai value of JSON written by [`keepable_json`]: a number written with a fraction
+/// The Rhai value of JSON written by [`to_json`] for a checkpoint: a number written with a fraction
 /// or exponent is a float, one without an integer (serde_json writes every f64 with one).
 pub fn from_json(v: &serde_json::Value) -> Dynamic {
     use serde_json::Value;

@@ -171,3 +171,25 @@ pub fn former_default_r(
         *r *= p_wave_over_young * area / (height * height);
     }
 }
+
+/// Runs `source` as the script `name.rhai` through the `tribo run` command line (output in a
+/// fresh folder under the system temp, `tag` keeping test files apart), with `extra`
+/// arguments; returns the exit code and stderr, and fails on a panic.
+pub fn run_script(tag: &str, name: &str, source: &str, extra: &[&str]) -> (i32, String) {
+    let dir = std::env::temp_dir().join(format!("tribo-{tag}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{name}.rhai"));
+    std::fs::write(&path, source).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .arg("run")
+        .arg(&path)
+        .args(["--quiet", "--out"])
+        .arg(dir.join("out"))
+        .args(extra)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!stderr.contains("panicked"), "{name}: panic: {stderr}");
+    (out.status.code().unwrap_or(-1), stderr)
+}
