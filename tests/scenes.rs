@@ -4,18 +4,15 @@
 //! outcome (finished, no increment above 25 Newton iterations, and a physical check such as
 //! Coulomb's ratio or a force balance); a failure names the script, line and column.
 
+mod common;
+
 use std::path::PathBuf;
 use tribo::script::{self, HostOptions};
 
 #[test]
 fn every_scene_finishes_with_engine_defaults() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes");
-    let mut scripts: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
-        .collect();
-    scripts.sort();
+    let scripts = common::rhai_scripts("scenes");
     assert!(scripts.len() >= 3, "scenes in {}", dir.display());
     let mut failures = Vec::new();
     for path in &scripts {

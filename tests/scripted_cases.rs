@@ -1,6 +1,8 @@
 //! Runs every tests/scripts/*.rhai through the script engine; a script error or a failed
 //! script assertion fails the test and names the file, line and column.
 
+mod common;
+
 use std::path::PathBuf;
 use tribo::script::{self, HostOptions};
 
@@ -11,12 +13,7 @@ fn out_dir(name: &str) -> PathBuf {
 #[test]
 fn every_scripted_case_passes() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scripts");
-    let mut scripts: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
-        .collect();
-    scripts.sort();
+    let scripts = common::rhai_scripts("scripts");
     assert!(
         !scripts.is_empty(),
         "no scripted cases in {}",

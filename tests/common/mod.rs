@@ -193,3 +193,17 @@ pub fn run_script(tag: &str, name: &str, source: &str, extra: &[&str]) -> (i32, 
     assert!(!stderr.contains("panicked"), "{name}: panic: {stderr}");
     (out.status.code().unwrap_or(-1), stderr)
 }
+
+/// The `*.rhai` files of `tests/<folder>`, sorted by name.
+pub fn rhai_scripts(folder: &str) -> Vec<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests")
+        .join(folder);
+    let mut scripts: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
+        .collect();
+    scripts.sort();
+    scripts
+}
