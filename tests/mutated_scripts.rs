@@ -124,36 +124,15 @@ fn campaign_sample_of_shipped_script_mutants() {
     let sample: Vec<_> = (0..SAMPLE)
         .map(|_| pool.swap_remove(rng.below(pool.len())))
         .collect();
-    let queue = std::sync::Arc::new(std::sync::Mutex::new(sample));
-    let tally = std::sync::Arc::new(std::sync::Mutex::new(mutate::Tally::default()));
     let base = std::env::temp_dir().join(format!("tribo-mutants-{}", std::process::id()));
-    let workers: Vec<_> = (0..2)
-        .map(|j| {
-            let (queue, tally, bin) = (queue.clone(), tally.clone(), bin.clone());
-            let work = base.join(format!("w{j}"));
-            std::thread::spawn(move || loop {
-                let Some((script, what, text)) = queue.lock().unwrap().pop() else {
-                    break;
-                };
-                let o = mutate::run_mutant(
-                    &bin,
-                    &script,
-                    &text,
-                    &work,
-                    std::time::Duration::from_secs(60),
-                );
-                tally
-                    .lock()
-                    .unwrap()
-                    .add(format!("{}: {what}", script.display()), &o);
-            })
-        })
-        .collect();
-    for w in workers {
-        w.join().unwrap();
-    }
-    let _ = std::fs::remove_dir_all(&base);
-    let t = tally.lock().unwrap();
+    let t = mutate::run_all(
+        &bin,
+        sample,
+        2,
+        std::time::Duration::from_secs(60),
+        &base,
+        None,
+    );
     println!(
         "{} mutants: {} ran, {} refused, {} panics, {} hangs, {} signals",
         t.tries,

@@ -11,7 +11,6 @@ mod mutate;
 
 use mutate::*;
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 fn listing(dirs: &[PathBuf]) -> Vec<PathBuf> {
@@ -70,36 +69,12 @@ fn main() {
     let before = listing(&dirs);
 
     let work_base = std::env::temp_dir().join(format!("tribo-campaign-{}", std::process::id()));
-    let queue = Arc::new(Mutex::new(pool));
-    let tally = Arc::new(Mutex::new(Tally::default()));
     let started = std::time::Instant::now();
-    let workers: Vec<_> = (0..jobs)
-        .map(|j| {
-            let (queue, tally, bin) = (queue.clone(), tally.clone(), bin.clone());
-            let work = work_base.join(format!("w{j}"));
-            std::thread::spawn(move || loop {
-                let Some((script, what, text)) = queue.lock().unwrap().pop() else {
-                    break;
-                };
-                let o = run_mutant(&bin, &script, &text, &work, limit);
-                let name = format!("{}: {what}", script.display());
-                let mut t = tally.lock().unwrap();
-                t.add(name, &o);
-                if t.tries % 250 == 0 {
-                    eprintln!("{} tried", t.tries);
-                }
-            })
-        })
-        .collect();
-    for w in workers {
-        w.join().unwrap();
-    }
+    let t = run_all(&bin, pool, jobs, limit, &work_base, Some(250));
     let escapes: Vec<PathBuf> = listing(&dirs)
         .into_iter()
         .filter(|p| !before.contains(p))
         .collect();
-    let _ = std::fs::remove_dir_all(&work_base);
-    let t = tally.lock().unwrap();
     for (what, list) in [
         ("panic", &t.panics),
         ("hang", &t.hangs),

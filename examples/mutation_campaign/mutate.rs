@@ -272,3 +272,42 @@ impl Tally {
         }
     }
 }
+
+/// Runs every mutant `(original script, what was mutated, mutated text)` on `jobs` threads,
+/// each in its own folder below `work_base` (removed afterwards), killed after `limit`;
+/// with `progress_every`, prints a count to stderr that often.
+pub fn run_all(
+    bin: &Path,
+    mutants: Vec<(PathBuf, String, String)>,
+    jobs: usize,
+    limit: Duration,
+    work_base: &Path,
+    progress_every: Option<usize>,
+) -> Tally {
+    use std::sync::{Arc, Mutex};
+    let queue = Arc::new(Mutex::new(mutants));
+    let tally = Arc::new(Mutex::new(Tally::default()));
+    let workers: Vec<_> = (0..jobs)
+        .map(|j| {
+            let (queue, tally, bin) = (queue.clone(), tally.clone(), bin.to_path_buf());
+            let work = work_base.join(format!("w{j}"));
+            std::thread::spawn(move || loop {
+                let Some((script, what, text)) = queue.lock().unwrap().pop() else {
+                    break;
+                };
+                let o = run_mutant(&bin, &script, &text, &work, limit);
+                let mut t = tally.lock().unwrap();
+                t.add(format!("{}: {what}", script.display()), &o);
+                if progress_every.is_some_and(|k| t.tries % k == 0) {
+                    eprintln!("{} tried", t.tries);
+                }
+            })
+        })
+        .collect();
+    for w in workers {
+        w.join().unwrap();
+    }
+    let _ = std::fs::remove_dir_all(work_base);
+    let tally = std::mem::take(&mut *tally.lock().unwrap());
+    tally
+}
