@@ -22,9 +22,11 @@ pub mod hex8;
 pub mod hex8_fbar;
 #[doc(hidden)]
 pub mod hex8_fbar_reference;
+pub mod solid_shell;
 
 pub use hex8::Hex8;
 pub use hex8_fbar::Hex8FBar;
+pub use solid_shell::{ElementKind, SolidShell};
 
 /// Kinematics of a model: which hexahedron the solver uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -83,7 +83,17 @@ pub struct PointState {
     /// or `∫ T·dEp` (finite strain), accumulated by the trapezoidal rule per increment
     /// (exact energy balance with the trapezoidal external work at small strain).
     pub plastic_dissipation: f64,
+    /// Element-level internal variables of the point's element, written by the element
+    /// (the enhanced-strain parameters of the solid-shell, `element::solid_shell`), carried
+    /// unchanged by the materials. Zero for elements without any. Absent from checkpoints
+    /// written before it existed (read as zero).
+    #[serde(default)]
+    pub enhanced: [f64; ENHANCED_PARAMETERS],
 }
+
+/// Number of element-level internal variables a [`PointState`] carries
+/// ([`PointState::enhanced`]).
+pub const ENHANCED_PARAMETERS: usize = 5;
 
 impl Default for PointState {
     /// The virgin state: stress- and strain-free, `F = I`.
@@ -96,6 +106,7 @@ impl Default for PointState {
             deformation_gradient: Mat3::identity(),
             log_stress: Voigt::zeros(),
             plastic_dissipation: 0.0,
+            enhanced: [0.0; ENHANCED_PARAMETERS],
         }
     }
 }

@@ -33,6 +33,7 @@ use crate::{Error, Result};
 
 mod block;
 mod faces;
+mod map;
 
 pub use block::{End, Grading, MAX_BLOCK_NODES};
 pub use faces::{quad_area, HEX_FACES};

@@ -652,6 +652,14 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
                     .map_err(|t| format!("fbar must be true or false, got {t}"))
                     .or_else(runtime_error)?
             }
+            "element" => {
+                let name = v.clone().into_string().unwrap_or_default();
+                s.element = lift(crate::element::ElementKind::from_name(&name))?;
+            }
+            "thickness_points" => {
+                s.thickness_points =
+                    lift(crate::element::solid_shell::check_thickness_points(count(key)?))?;
+            }
             "friction_update" => {
                 s.contact.friction_update = match v.clone().into_string().unwrap_or_default().as_str() {
                     "explicit" => crate::contact::FrictionUpdate::Explicit,
@@ -682,7 +690,7 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, linear_solver, extrapolate, threads, kinematics, fbar, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
+                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, linear_solver, extrapolate, threads, kinematics, fbar, element, thickness_points, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
                 ))
             }
         }

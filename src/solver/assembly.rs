@@ -20,7 +20,7 @@ use crate::contact::{
     alart_curnier, BernsteinLaw, ContactNodeState, Enforcement, FrictionUpdate, NodalContact,
     OperatorParams,
 };
-use crate::element::{hexahedron, in_element};
+use crate::element::in_element;
 use crate::geometry::{Mat3, Projection, Vec3};
 use crate::material::PointState;
 use crate::tool::pose::Pose;
@@ -153,7 +153,7 @@ fn evaluate_elements(
     tangent: bool,
 ) -> Result<ElementBuffers> {
     const D: usize = crate::element::hex8::DOFS;
-    let element = hexahedron(model.settings.kinematics, model.settings.fbar);
+    let element = model.element()?;
     let per_elem = element.point_count();
     let (hexes, nodes, material) = (
         &model.mesh.hexes,

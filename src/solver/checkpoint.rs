@@ -329,6 +329,7 @@ impl Checkpoint {
                     "deformation_gradient",
                     point.deformation_gradient.as_slice(),
                 ),
+                ("enhanced", point.enhanced.as_slice()),
             ] {
                 for (i, &v) in values.iter().enumerate() {
                     finite(&|| format!("{}[{i}]", field(name)), v)?;

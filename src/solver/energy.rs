@@ -41,21 +41,22 @@ impl Simulation {
             e.tool_work -= normal_work[c];
             e.normal_contact_work += normal_work[c];
         }
-        let element =
-            crate::element::hexahedron(self.model.settings.kinematics, self.model.settings.fbar);
-        e.elastic_energy = crate::element::total_strain_energy(
-            &self.model.mesh,
-            element,
-            &eval.trial_points,
-            self.model.material.as_ref(),
-        )
-        .unwrap_or(f64::NAN);
-        e.plastic_dissipation = crate::element::total_plastic_dissipation(
-            &self.model.mesh,
-            element,
-            &eval.trial_points,
-        )
-        .unwrap_or(f64::NAN);
+        // The element was checked when the simulation was set up.
+        if let Ok(element) = self.model.element() {
+            e.elastic_energy = crate::element::total_strain_energy(
+                &self.model.mesh,
+                element,
+                &eval.trial_points,
+                self.model.material.as_ref(),
+            )
+            .unwrap_or(f64::NAN);
+            e.plastic_dissipation = crate::element::total_plastic_dissipation(
+                &self.model.mesh,
+                element,
+                &eval.trial_points,
+            )
+            .unwrap_or(f64::NAN);
+        }
         let input = e.tool_work + e.load_work + e.support_work;
         let stored: f64 =
             e.elastic_energy + e.plastic_dissipation + e.frictional_dissipation.iter().sum::<f64>();

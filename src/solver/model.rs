@@ -72,6 +72,10 @@ pub struct SolverSettings {
     /// F-bar volumetric treatment of the finite-strain hexahedron (default on; off gives
     /// the fully integrated element, which locks: for verification only).
     pub fbar: bool,
+    /// The hexahedron of the strain theory or the solid-shell (`element::solid_shell`).
+    pub element: crate::element::ElementKind,
+    /// Gauss points through the thickness of the solid-shell.
+    pub thickness_points: usize,
     /// Increment control, line search, anti-cycling and rollback depth.
     pub stepping: super::step_control::StepSettings,
     /// Start each increment's Newton iteration from the last increment's change of the
@@ -97,6 +101,8 @@ impl Default for SolverSettings {
             linear_solver: Default::default(),
             kinematics: crate::element::StrainTheory::Small,
             fbar: true,
+            element: crate::element::ElementKind::Hexahedron,
+            thickness_points: crate::element::solid_shell::DEFAULT_THICKNESS_POINTS,
             stepping: Default::default(),
             extrapolate: true,
             threads: 0,
@@ -126,6 +132,12 @@ impl Model {
             contacts: Vec::new(),
             settings: SolverSettings::default(),
         })
+    }
+
+    /// The element the settings select (see `element::solid_shell::select`).
+    pub fn element(&self) -> Result<&'static dyn crate::element::Element<{ crate::element::hex8::DOFS }>> {
+        let s = &self.settings;
+        crate::element::solid_shell::select(s.element, s.kinematics, s.fbar, s.thickness_points)
     }
 
     /// Node set by name (a face "x-", ..., or one the script defined).

@@ -15,7 +15,6 @@ use super::newton::{IterationRecord, Trial};
 use super::sparse::SparsePattern;
 use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
-use crate::element::{Element, Hex8};
 use crate::geometry::Vec3;
 use crate::material::PointState;
 use crate::{Error, Result};
@@ -128,7 +127,11 @@ impl Simulation {
                 is_fixed[3 * node + bc.component] = true;
             }
         }
-        let points = vec![PointState::default(); model.mesh.hexes.len() * Hex8.point_count()];
+        let element = model.element()?;
+        if model.settings.element == crate::element::ElementKind::SolidShell {
+            crate::element::solid_shell::check_columns(&model.mesh)?;
+        }
+        let points = vec![PointState::default(); model.mesh.hexes.len() * element.point_count()];
         let contact = model
             .contacts
             .iter()
@@ -687,9 +690,11 @@ impl Simulation {
             || settings.eliminate_multipliers != old.eliminate_multipliers
             || settings.kinematics != old.kinematics
             || settings.fbar != old.fbar
+            || settings.element != old.element
+            || settings.thickness_points != old.thickness_points
         {
             return Err(Error::Input(
-                "enforcement, eliminate_multipliers, kinematics and fbar cannot change once the simulation has started"
+                "enforcement, eliminate_multipliers, kinematics, fbar, element and thickness_points cannot change once the simulation has started"
                     .into(),
             ));
         }

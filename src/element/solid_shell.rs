@@ -1,0 +1,784 @@
+//! The solid-shell hexahedron: 8 nodes, displacement degrees of freedom only, for thin
+//! sheets modelled with one element through the thickness (Hauptmann & Schweizerhof 1998,
+//! Vu-Quoc & Tan 2003, Klinkel, Gruttmann & Wagner 2006). See `docs/solid-shell.md`.
+//!
+//! # Thickness direction
+//!
+//! The element's natural axis `ζ` (nodes 0-3 → 4-7) is the sheet's thickness direction:
+//! [`check_columns`] verifies that every element edge `a → a + 4` is a step up one of the
+//! mesh's through-thickness node columns ([`Mesh::columns`]).
+//!
+//! # Strains
+//!
+//! Total Lagrangian. With the covariant base vectors `G_α = ∂X/∂ξ_α`, `g_α = G_α + d_α`,
+//! `d_α = ∂u/∂ξ_α`, the covariant Green-Lagrange strains are
+//! `E_αβ = ½ (G_α·d_β + d_α·G_β + d_α·d_β)` (formed from `d`, so that a strain of `10⁻⁶`
+//! keeps its relative precision; small strain drops `d_α·d_β`). At an integration point
+//! `(ξ, η, ζ)`:
+//!
+//! * in-plane `E_11, E_22, E_12`: compatible, at the point;
+//! * transverse shear (Dvorkin & Bathe 1986, assumed natural strain): `E_13` interpolated
+//!   linearly in `η` from the mid-edge tying points `(0, ∓1, ζ)`, `E_23` linearly in `ξ`
+//!   from `(∓1, 0, ζ)`: cures transverse-shear locking;
+//! * thickness `E_33` (Betsch & Stein 1995): interpolated bilinearly in `(ξ, η)` from the
+//!   four corner lines `(±1, ±1)`: cures trapezoidal (curvature-thickness) locking of
+//!   curved and distorted meshes.
+//!
+//! These covariant components are mapped to the reference Cartesian frame,
+//! `E = J⁻ᵀ E_cov J⁻¹` (`J = [G_1 G_2 G_3]` at the point), and the enhanced assumed strain
+//! (EAS, Simo & Rifai 1990, Büchter, Ramm & Roehl 1994) is added, `Ẽ = Σ_m M_m α_m`:
+//!
+//! * thickness mode: `M_0 = (ζ - ζ̄) n ⊗ n`, `n = G³₀/|G³₀|` the normalised contravariant
+//!   thickness vector at the element centre, `ζ̄` the volume-weighted mean of `ζ` along the
+//!   point's in-plane position (zero unless the thickness tapers). It makes the thickness
+//!   strain linear through the thickness (compatible `E_33` is constant in `ζ` for a
+//!   trilinear hexahedron): cures thickness (Poisson) locking in bending. Subtracting `ζ̄`
+//!   keeps `∫ M_0 : S dV = 0` for a constant stress on any hexahedron (membrane patch test),
+//!   and on flat elements it is `ζ n ⊗ n` at every point, so that the linear thickness strain
+//!   of pure bending is exact on distorted meshes (bending patch test).
+//! * with `membrane_modes`, four in-plane modes `(j₀/j) ξ G¹₀⊗G¹₀ |G₁₀|²`,
+//!   `(j₀/j) η G²₀⊗G²₀ |G₂₀|²`, `(j₀/j) {ξ, η} sym(G¹₀⊗G²₀) |G₁₀||G₂₀|` (the EAS-4 membrane
+//!   modes with the centre transformation of Simo & Rifai), against in-plane shear locking.
+//!
+//! The material sees `C = I + 2E` (any symmetric positive definite `C` is the right
+//! Cauchy-Green tensor of its stretch `U = √C`, and the log-strain materials depend on `C`
+//! only), through [`Material::update_finite_displacement_gradient`] at `h = U - I` formed as
+//! `Q diag(μ / (1 + √(1 + μ))) Qᵀ` from the eigenpairs of `2E` (no round-off against `I`);
+//! under small strain [`Material::update`] at `ε = E`.
+//!
+//! # Element-level condensation of the EAS parameters
+//!
+//! With `W = Σ_p w_p ψ(E_p(u, α))`, `r_u = Σ w Bᵀ S`, `r_α = Σ w Mᵀ S`: the parameters `α`
+//! solve `r_α(u, α) = 0` by a local Newton iteration started from the committed values
+//! (`PointState::enhanced`, so they are saved across increments and in checkpoints), and
+//!
+//! ```text
+//! f = r_u(u, α(u)),    K = K_uu - K_uα K_αα⁻¹ K_αu,
+//! K_uu = Σ w (Bᵀ ℂ B + G(S)),  K_uα = Σ w Bᵀ ℂ M,  K_αu = Σ w Mᵀ ℂ B,  K_αα = Σ w Mᵀ ℂ M,
+//! ```
+//!
+//! the exact derivative of `f` (implicit function theorem). Solving `α` to convergence in
+//! every call keeps the element a function of `(u, committed)` only, like every other
+//! element: a Newton iterate, a line-search trial and a cut-back step never depend on the
+//! previous iterate. `G(S)` is the geometric stiffness `Σ_c S^c ∂²E_c/∂u²` of the
+//! (ANS-interpolated) covariant strains.
+//!
+//! # Integration and cost
+//!
+//! 2 x 2 Gauss points in plane (full: no hourglass modes) times `n` Gauss-Legendre points
+//! through the thickness (default 5): point `k * 4 + q` is in-plane point `q` (in the
+//! order of the corners 0-3) at thickness level `k` (bottom to top). Per point and local
+//! iteration: one material update (plus one 3 x 3 eigen-decomposition under finite
+//! strain); per point once: `Bᵀ ℂ B`, ~4.3k multiplications.
+
+use nalgebra::{DMatrix, DVector, SMatrix, SymmetricEigen};
+
+use super::hex8::{jacobian, shape_derivatives, DOFS, NODES};
+use super::{prefix, Element, ElementResponse};
+use crate::geometry::{Mat3, Vec3};
+use crate::material::{
+    strain_from_tensor, strain_to_tensor, stress_from_tensor, stress_to_tensor, Kinematics,
+    Material, PointState, Tangent, Voigt, ENHANCED_PARAMETERS,
+};
+use crate::mesh::Mesh;
+use crate::{Error, Result};
+
+/// Most thickness points an element may have.
+pub const MAX_THICKNESS_POINTS: usize = 12;
+/// Thickness points unless the settings say otherwise.
+pub const DEFAULT_THICKNESS_POINTS: usize = 5;
+
+/// Covariant strain components in Voigt order: `(α, β)` of `xx, yy, zz, xy, yz, zx`.
+const COMPONENTS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)];
+
+/// In-plane Gauss abscissa `1/√3`.
+const GAUSS: f64 = 0.577_350_269_189_625_8;
+
+/// Most local Newton iterations for the EAS parameters.
+const MAX_LOCAL_ITERATIONS: usize = 30;
+
+/// The solid-shell hexahedron; see the module docs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SolidShell {
+    /// Finite strain (total Lagrangian, log-strain material update) or small strain.
+    pub finite: bool,
+    /// Gauss points through the thickness, `1..=MAX_THICKNESS_POINTS`.
+    pub thickness_points: usize,
+    /// The four in-plane EAS modes besides the thickness mode.
+    pub membrane_modes: bool,
+}
+
+/// Which hexahedron a model uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ElementKind {
+    /// The 8-node hexahedron of the strain theory (B-bar small strain, F-bar finite).
+    #[default]
+    Hexahedron,
+    /// The solid-shell ([`SolidShell`]).
+    SolidShell,
+}
+
+impl ElementKind {
+    /// The script name: "hexahedron" or "solid_shell".
+    pub fn name(self) -> &'static str {
+        match self {
+            ElementKind::Hexahedron => "hexahedron",
+            ElementKind::SolidShell => "solid_shell",
+        }
+    }
+
+    /// From the script name; errors name the value and the choices.
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "hexahedron" => Ok(ElementKind::Hexahedron),
+            "solid_shell" => Ok(ElementKind::SolidShell),
+            other => Err(Error::input(
+                "element",
+                format!("\"{other}\""),
+                "must be \"hexahedron\" or \"solid_shell\"",
+            )),
+        }
+    }
+}
+
+/// Checks a thickness-point count from the settings.
+pub fn check_thickness_points(n: usize) -> Result<usize> {
+    if (1..=MAX_THICKNESS_POINTS).contains(&n) {
+        Ok(n)
+    } else {
+        Err(Error::input(
+            "thickness_points",
+            n,
+            &format!("must be a whole number from 1 to {MAX_THICKNESS_POINTS}"),
+        ))
+    }
+}
+
+const fn shell_table<const N: usize>(finite: bool) -> [SolidShell; N] {
+    let mut t = [SolidShell {
+        finite,
+        thickness_points: 0,
+        membrane_modes: true,
+    }; N];
+    let mut i = 0;
+    while i < N {
+        t[i].thickness_points = i;
+        i += 1;
+    }
+    t
+}
+
+static SMALL_SHELLS: [SolidShell; MAX_THICKNESS_POINTS + 1] = shell_table(false);
+static FINITE_SHELLS: [SolidShell; MAX_THICKNESS_POINTS + 1] = shell_table(true);
+
+/// The element a model's settings select: the hexahedron of the strain theory
+/// ([`super::hexahedron`]) or the solid-shell with `thickness_points` points through the
+/// thickness. Errors: a thickness-point count out of range.
+pub fn select(
+    kind: ElementKind,
+    theory: super::StrainTheory,
+    fbar: bool,
+    thickness_points: usize,
+) -> Result<&'static dyn Element<DOFS>> {
+    match kind {
+        ElementKind::Hexahedron => Ok(super::hexahedron(theory, fbar)),
+        ElementKind::SolidShell => {
+            let n = check_thickness_points(thickness_points)?;
+            Ok(match theory {
+                super::StrainTheory::Small => &SMALL_SHELLS[n],
+                super::StrainTheory::Finite => &FINITE_SHELLS[n],
+            })
+        }
+    }
+}
+
+/// Checks that every element of `mesh` stands in its through-thickness node columns
+/// ([`Mesh::columns`]) with nodes 4-7 one step above nodes 0-3, as the solid-shell needs
+/// (its `ζ` axis is the thickness direction). Errors name the fault and the element.
+pub fn check_columns(mesh: &Mesh) -> Result<()> {
+    if mesh.columns().is_empty() {
+        return Err(Error::Input(
+            "element \"solid_shell\": the mesh has no through-thickness node columns (a block \
+             mesh has them, also after mesh.map); the solid-shell takes its thickness \
+             direction from them"
+                .into(),
+        ));
+    }
+    let mut place = vec![None; mesh.node_count()];
+    for (c, col) in mesh.columns().iter().enumerate() {
+        for (k, &n) in col.iter().enumerate() {
+            place[n] = Some((c, k));
+        }
+    }
+    for (e, hex) in mesh.hexes.iter().enumerate() {
+        for a in 0..4 {
+            let (lo, hi) = (hex[a], hex[a + 4]);
+            let ok = matches!((place[lo], place[hi]),
+                (Some((c0, k0)), Some((c1, k1))) if c0 == c1 && k1 == k0 + 1);
+            if !ok {
+                return Err(Error::Input(format!(
+                    "element {e}: element \"solid_shell\" needs its edge from local node {a} \
+                     (node {lo}) to local node {} (node {hi}) to be one step up a \
+                     through-thickness node column; it is not",
+                    a + 4
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Gauss-Legendre points and weights on `[-1, 1]`, ascending (Newton on the Legendre
+/// recurrence; exact to round-off).
+pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut x = Vec::with_capacity(n);
+    let mut w = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, z);
+            for k in 2..=n {
+                let kf = k as f64;
+                let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
+                p0 = p1;
+                p1 = p2;
+            }
+            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
+            let dz = p1 / dp;
+            z -= dz;
+            if dz.abs() < 1e-16 {
+                break;
+            }
+        }
+        // Final derivative at the converged root.
+        let (mut p0, mut p1) = (1.0, z);
+        for k in 2..=n {
+            let kf = k as f64;
+            let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
+            p0 = p1;
+            p1 = p2;
+        }
+        if n > 1 {
+            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
+        }
+        x.push(z);
+        w.push(2.0 / ((1.0 - z * z) * dp * dp));
+    }
+    x.reverse();
+    w.reverse();
+    (x, w)
+}
+
+/// In-plane natural coordinates of point `q` (corner order 0-3).
+fn in_plane(q: usize) -> (f64, f64) {
+    let c = crate::mesh::HEX_CORNERS[q];
+    (c[0] * GAUSS, c[1] * GAUSS)
+}
+
+/// Tying locations of one thickness level: 0-3 the in-plane points, 4-7 the corner lines
+/// (E₃₃), 8-9 `(∓1, 0)` (E₂₃), 10-11 `(0, ∓1)` (E₁₃).
+const LOCATIONS: usize = 12;
+
+fn location(l: usize) -> (f64, f64) {
+    match l {
+        0..=3 => in_plane(l),
+        4..=7 => {
+            let c = crate::mesh::HEX_CORNERS[l - 4];
+            (c[0], c[1])
+        }
+        8 => (-1.0, 0.0),
+        9 => (1.0, 0.0),
+        10 => (0.0, -1.0),
+        _ => (0.0, 1.0),
+    }
+}
+
+/// The sampling of covariant component `c` at in-plane point `q`: `(location, weight)`
+/// pairs, `len` of them.
+fn samples(q: usize, c: usize) -> ([(usize, f64); 4], usize) {
+    let (xi, eta) = in_plane(q);
+    let mut s = [(0, 0.0); 4];
+    match c {
+        2 => {
+            for (i, out) in s.iter_mut().enumerate() {
+                let k = crate::mesh::HEX_CORNERS[i];
+                *out = (4 + i, 0.25 * (1.0 + k[0] * xi) * (1.0 + k[1] * eta));
+            }
+            (s, 4)
+        }
+        4 => {
+            s[0] = (8, 0.5 * (1.0 - xi));
+            s[1] = (9, 0.5 * (1.0 + xi));
+            (s, 2)
+        }
+        5 => {
+            s[0] = (10, 0.5 * (1.0 - eta));
+            s[1] = (11, 0.5 * (1.0 + eta));
+            (s, 2)
+        }
+        _ => {
+            s[0] = (q, 1.0);
+            (s, 1)
+        }
+    }
+}
+
+/// Kinematics of one tying location: natural derivatives, `J = [G_α]`, `D = [d_α]`.
+struct Location {
+    dn: [Vec3; NODES],
+    j: Mat3,
+    d: Mat3,
+}
+
+/// What one integration point keeps between the local iterations and the assembly.
+struct Point {
+    /// Cartesian Green-Lagrange strain from the displacements alone (engineering shear).
+    strain: Voigt,
+    /// `∂E/∂u` (6 x 24).
+    b: SMatrix<f64, 6, DOFS>,
+    /// Covariant-to-Cartesian map of engineering strain vectors.
+    t: Tangent,
+    /// EAS modes (Cartesian, engineering shear), one column per parameter.
+    modes: [Voigt; ENHANCED_PARAMETERS],
+    /// Reference volume weight.
+    dv: f64,
+    /// Compatible deformation gradient at the point (for the Cauchy stress and the
+    /// rotation measure of the step control).
+    f: Mat3,
+    /// Thickness level and in-plane index.
+    level: usize,
+    q: usize,
+}
+
+/// `U - I` for `C = I + a` (`a = 2E`), without round-off against `I`.
+fn stretch_minus_identity(a: &Mat3) -> Result<Mat3> {
+    if !a.iter().all(|v| v.is_finite()) {
+        return Err(Error::NoConvergence("non-finite enhanced strain".into()));
+    }
+    let eig = SymmetricEigen::new((a + a.transpose()) * 0.5);
+    let mut d = Vec3::zeros();
+    for i in 0..3 {
+        let mu = eig.eigenvalues[i];
+        if mu.is_nan() || mu <= -1.0 {
+            return Err(Error::NoConvergence(format!(
+                "enhanced strain with a stretch eigenvalue {} (inverted material)",
+                1.0 + mu
+            )));
+        }
+        d[i] = mu / (1.0 + (1.0 + mu).sqrt());
+    }
+    let q = eig.eigenvectors;
+    Ok(q * Mat3::from_diagonal(&d) * q.transpose())
+}
+
+impl SolidShell {
+    /// Number of active EAS parameters.
+    fn modes(&self) -> usize {
+        if self.membrane_modes {
+            5
+        } else {
+            1
+        }
+    }
+
+    /// The reference quantities and displacement strains of every point.
+    fn points(&self, x: &[Vec3; NODES], u: &[Vec3; NODES]) -> Result<Vec<Point>> {
+        let n = self.thickness_points;
+        let (zeta, wz) = gauss_legendre(n);
+        let centre = jacobian(x, &Vec3::zeros());
+        let j0 = centre.determinant();
+        let inv0 = match centre.try_inverse() {
+            Some(inv) if j0 > 0.0 && j0.is_finite() => inv,
+            _ => {
+                return Err(Error::input(
+                    "Jacobian determinant at the element centre",
+                    j0,
+                    "must be > 0 (inverted or degenerate element)",
+                ))
+            }
+        };
+        let contra: [Vec3; 3] = std::array::from_fn(|i| inv0.row(i).transpose());
+        let len: [f64; 3] = std::array::from_fn(|i| centre.column(i).norm());
+        let n3 = contra[2].normalize();
+        let tensor_mode = |m: Mat3| strain_from_tensor(&m);
+        let thickness_mode = tensor_mode(n3 * n3.transpose());
+        let m11 = tensor_mode(contra[0] * contra[0].transpose() * (len[0] * len[0]));
+        let m22 = tensor_mode(contra[1] * contra[1].transpose() * (len[1] * len[1]));
+        let g12 = contra[0] * contra[1].transpose() * (len[0] * len[1]);
+        let m12 = tensor_mode((g12 + g12.transpose()) * 0.5);
+        // Jacobian determinants of every point, for ζ̄.
+        let dets: Vec<f64> = (0..4 * n)
+            .map(|p| {
+                let (xi, eta) = in_plane(p % 4);
+                jacobian(x, &Vec3::new(xi, eta, zeta[p / 4])).determinant()
+            })
+            .collect();
+        let zeta_bar: [f64; 4] = std::array::from_fn(|q| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for k in 0..n {
+                num += wz[k] * zeta[k] * dets[4 * k + q];
+                den += wz[k] * dets[4 * k + q];
+            }
+            num / den
+        });
+        let mut points = Vec::with_capacity(4 * n);
+        for (k, &z) in zeta.iter().enumerate() {
+            let locations: [Location; LOCATIONS] = std::array::from_fn(|l| {
+                let (xi, eta) = location(l);
+                let dn = shape_derivatives(&Vec3::new(xi, eta, z));
+                let j = (0..NODES).fold(Mat3::zeros(), |m, a| m + x[a] * dn[a].transpose());
+                let d = (0..NODES).fold(Mat3::zeros(), |m, a| m + u[a] * dn[a].transpose());
+                Location { dn, j, d }
+            });
+            for q in 0..4 {
+                let p = 4 * k + q;
+                let jp = locations[q].j;
+                let det = dets[p];
+                let inv = match jp.try_inverse() {
+                    Some(inv) if det > 0.0 && det.is_finite() => inv,
+                    _ => {
+                        return Err(Error::input(
+                            &format!("Jacobian determinant at integration point {p}"),
+                            det,
+                            "must be > 0 (inverted or degenerate element)",
+                        ))
+                    }
+                };
+                let mut e_cov = Voigt::zeros();
+                let mut b_cov = SMatrix::<f64, 6, DOFS>::zeros();
+                for (c, &(al, be)) in COMPONENTS.iter().enumerate() {
+                    let s = if al == be { 0.5 } else { 1.0 };
+                    let (list, count) = samples(q, c);
+                    for &(l, phi) in &list[..count] {
+                        let loc = &locations[l];
+                        let (ga, gb) = (loc.j.column(al), loc.j.column(be));
+                        let (da, db) = (loc.d.column(al), loc.d.column(be));
+                        let mut value = ga.dot(&db) + da.dot(&gb);
+                        let (cur_a, cur_b) = if self.finite {
+                            value += da.dot(&db);
+                            (ga + da, gb + db)
+                        } else {
+                            (ga.into_owned(), gb.into_owned())
+                        };
+                        e_cov[c] += phi * s * value;
+                        for a in 0..NODES {
+                            let v = (cur_b * loc.dn[a][al] + cur_a * loc.dn[a][be]) * (phi * s);
+                            for kk in 0..3 {
+                                b_cov[(c, 3 * a + kk)] += v[kk];
+                            }
+                        }
+                    }
+                }
+                let t = Tangent::from_fn(|_, _| 0.0);
+                let t = (0..6).fold(t, |mut t, m| {
+                    let mut unit = Voigt::zeros();
+                    unit[m] = 1.0;
+                    let cart = inv.transpose() * strain_to_tensor(&unit) * inv;
+                    t.set_column(m, &strain_from_tensor(&cart));
+                    t
+                });
+                let (xi, eta) = in_plane(q);
+                let scale = j0 / det;
+                let mut modes = [Voigt::zeros(); ENHANCED_PARAMETERS];
+                modes[0] = thickness_mode * (z - zeta_bar[q]);
+                if self.membrane_modes {
+                    modes[1] = m11 * (scale * xi);
+                    modes[2] = m22 * (scale * eta);
+                    modes[3] = m12 * (scale * xi);
+                    modes[4] = m12 * (scale * eta);
+                }
+                let h = locations[q].d * inv;
+                points.push(Point {
+                    strain: t * e_cov,
+                    b: t * b_cov,
+                    t,
+                    modes,
+                    dv: wz[k] * det,
+                    f: Mat3::identity() + h,
+                    level: k,
+                    q,
+                });
+            }
+            // The locations are needed again for the geometric stiffness: recomputed
+            // there (cheap), not kept.
+        }
+        Ok(points)
+    }
+
+    /// The material at point `p` with the EAS parameters `alpha`: PK2 (or small-strain)
+    /// stress and tangent; writes `trial`.
+    fn material_at(
+        &self,
+        point: &Point,
+        alpha: &[f64],
+        committed: &PointState,
+        trial: &mut PointState,
+        material: &dyn Material,
+    ) -> Result<(Voigt, Tangent)> {
+        let mut e = point.strain;
+        for (m, a) in alpha.iter().enumerate() {
+            e += point.modes[m] * *a;
+        }
+        let (s, c) = if self.finite {
+            let h = stretch_minus_identity(&(strain_to_tensor(&e) * 2.0))?;
+            let resp = material.update_finite_displacement_gradient(&h, committed, trial)?;
+            let f = &point.f;
+            let j = f.determinant();
+            trial.stress =
+                stress_from_tensor(&(f * stress_to_tensor(&resp.pk2) * f.transpose() / j));
+            (resp.pk2, resp.tangent)
+        } else {
+            let kin = Kinematics {
+                strain: e,
+                deformation_gradient: point.f,
+            };
+            let c = material.update(&kin, committed, trial)?;
+            (trial.stress, c)
+        };
+        trial.deformation_gradient = point.f;
+        trial.enhanced = [0.0; ENHANCED_PARAMETERS];
+        trial.enhanced[..alpha.len()].copy_from_slice(alpha);
+        Ok((s, c))
+    }
+
+    /// Adds the geometric stiffness `Σ_c S^c ∂²E_c/∂u²` of every point to `k`.
+    fn add_geometric(
+        &self,
+        points: &[Point],
+        stresses: &[Voigt],
+        k: &mut SMatrix<f64, DOFS, DOFS>,
+    ) {
+        let (zeta, _) = gauss_legendre(self.thickness_points);
+        let mut g = [[0.0; NODES]; NODES];
+        for (point, s) in points.iter().zip(stresses) {
+            let s_cov = point.t.transpose() * s * point.dv;
+            let z = zeta[point.level];
+            for (c, &(al, be)) in COMPONENTS.iter().enumerate() {
+                let half = if al == be { 0.5 } else { 1.0 };
+                let (list, count) = samples(point.q, c);
+                for &(l, phi) in &list[..count] {
+                    let (xi, eta) = location(l);
+                    let dn = shape_derivatives(&Vec3::new(xi, eta, z));
+                    let coef = s_cov[c] * phi * half;
+                    for a in 0..NODES {
+                        for b in 0..NODES {
+                            g[a][b] += coef * (dn[a][al] * dn[b][be] + dn[a][be] * dn[b][al]);
+                        }
+                    }
+                }
+            }
+        }
+        for a in 0..NODES {
+            for b in 0..NODES {
+                for d in 0..3 {
+                    k[(3 * a + d, 3 * b + d)] += g[a][b];
+                }
+            }
+        }
+    }
+
+    fn check(&self, committed: &[PointState], trial: &[PointState]) -> Result<()> {
+        check_thickness_points(self.thickness_points)?;
+        let np = self.point_count();
+        for (what, len) in [("committed", committed.len()), ("trial", trial.len())] {
+            if len != np {
+                return Err(Error::input(
+                    &format!("length of {what}"),
+                    len,
+                    &format!("must be {np} for this solid-shell"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn nodes(what: &str, v: &[Vec3]) -> Result<[Vec3; NODES]> {
+    super::hex8::check_len(what, v.len(), NODES)?;
+    Ok(std::array::from_fn(|a| v[a]))
+}
+
+impl Element<DOFS> for SolidShell {
+    fn node_count(&self) -> usize {
+        NODES
+    }
+
+    fn point_count(&self) -> usize {
+        4 * self.thickness_points
+    }
+
+    fn evaluate(
+        &self,
+        ref_coords: &[Vec3],
+        u: &[Vec3],
+        committed: &[PointState],
+        trial: &mut [PointState],
+        material: &dyn Material,
+    ) -> Result<ElementResponse<DOFS>> {
+        let mut force = nalgebra::SVector::<f64, DOFS>::zeros();
+        let mut stiffness = SMatrix::<f64, DOFS, DOFS>::zeros();
+        self.evaluate_into(
+            ref_coords,
+            u,
+            committed,
+            trial,
+            material,
+            force.as_mut_slice(),
+            Some(stiffness.as_mut_slice()),
+        )?;
+        Ok(ElementResponse { force, stiffness })
+    }
+
+    fn evaluate_into(
+        &self,
+        ref_coords: &[Vec3],
+        u: &[Vec3],
+        committed: &[PointState],
+        trial: &mut [PointState],
+        material: &dyn Material,
+        force: &mut [f64],
+        stiffness: Option<&mut [f64]>,
+    ) -> Result<()> {
+        super::hex8::check_len("force", force.len(), DOFS)?;
+        if let Some(k) = &stiffness {
+            super::hex8::check_len("stiffness", k.len(), DOFS * DOFS)?;
+        }
+        self.check(committed, trial)?;
+        let x = nodes("ref_coords", ref_coords)?;
+        let u = nodes("u", u)?;
+        let points = self.points(&x, &u)?;
+        let ne = self.modes();
+        let mut alpha: Vec<f64> = committed[0].enhanced[..ne].to_vec();
+        let strain_scale = points
+            .iter()
+            .map(|p| p.strain.amax())
+            .fold(0.0, f64::max);
+        let mut stresses = vec![Voigt::zeros(); points.len()];
+        let mut tangents = vec![Tangent::zeros(); points.len()];
+        let mut k_aa = DMatrix::<f64>::zeros(ne, ne);
+        let mut previous_step = f64::INFINITY;
+        for iteration in 0.. {
+            let mut r_a = DVector::<f64>::zeros(ne);
+            k_aa.fill(0.0);
+            for (p, point) in points.iter().enumerate() {
+                let (s, c) = self
+                    .material_at(point, &alpha, &committed[p], &mut trial[p], material)
+                    .map_err(|e| prefix(e, &format!("integration point {p}")))?;
+                for m in 0..ne {
+                    let cm = c * point.modes[m];
+                    r_a[m] += point.dv * point.modes[m].dot(&s);
+                    for l in 0..ne {
+                        k_aa[(l, m)] += point.dv * point.modes[l].dot(&cm);
+                    }
+                }
+                stresses[p] = s;
+                tangents[p] = c;
+            }
+            let step = k_aa.clone().lu().solve(&r_a).ok_or_else(|| {
+                Error::NoConvergence("singular enhanced-strain stiffness".into())
+            })?;
+            let size = step.amax();
+            let scale = strain_scale.max(alpha.iter().fold(0.0, |m, a| m.max(a.abs())));
+            // Converged, or stalled at round-off (the step no longer shrinks).
+            if size <= 1e-14 * scale
+                || (iteration >= 2 && size <= 1e-9 * scale && size > 0.25 * previous_step)
+            {
+                break;
+            }
+            if iteration >= MAX_LOCAL_ITERATIONS || !size.is_finite() {
+                return Err(Error::NoConvergence(format!(
+                    "enhanced-strain parameters not converged after {iteration} local \
+                     iterations (last step {size:e})"
+                )));
+            }
+            previous_step = size;
+            for (a, d) in alpha.iter_mut().zip(step.iter()) {
+                *a -= d;
+            }
+        }
+        let force: &mut [f64; DOFS] = force.try_into().expect("length checked");
+        force.fill(0.0);
+        for (point, s) in points.iter().zip(&stresses) {
+            let f = point.b.transpose() * s * point.dv;
+            for i in 0..DOFS {
+                force[i] += f[i];
+            }
+        }
+        let Some(k_out) = stiffness else {
+            return Ok(());
+        };
+        let mut k = SMatrix::<f64, DOFS, DOFS>::zeros();
+        let mut k_ua = DMatrix::<f64>::zeros(DOFS, ne);
+        let mut k_au = DMatrix::<f64>::zeros(ne, DOFS);
+        for (point, c) in points.iter().zip(&tangents) {
+            let cb = c * point.b * point.dv;
+            k += point.b.transpose() * cb;
+            for m in 0..ne {
+                let mode = &point.modes[m];
+                let row = mode.transpose() * cb;
+                let col = point.b.transpose() * (c * mode) * point.dv;
+                for i in 0..DOFS {
+                    k_au[(m, i)] += row[i];
+                    k_ua[(i, m)] += col[i];
+                }
+            }
+        }
+        if self.finite {
+            self.add_geometric(&points, &stresses, &mut k);
+        }
+        let lu = k_aa.lu();
+        let correction = lu
+            .solve(&k_au)
+            .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))?;
+        let condensed = &k_ua * correction;
+        for j in 0..DOFS {
+            for i in 0..DOFS {
+                k[(i, j)] -= condensed[(i, j)];
+            }
+        }
+        k_out.copy_from_slice(k.as_slice());
+        Ok(())
+    }
+
+    fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>> {
+        let x = nodes("ref_coords", ref_coords)?;
+        let (zeta, wz) = gauss_legendre(self.thickness_points);
+        let mut out = Vec::with_capacity(self.point_count());
+        for (k, z) in zeta.iter().enumerate() {
+            for q in 0..4 {
+                let (xi, eta) = in_plane(q);
+                let det = jacobian(&x, &Vec3::new(xi, eta, *z)).determinant();
+                if !(det > 0.0 && det.is_finite()) {
+                    return Err(Error::input(
+                        &format!("Jacobian determinant at integration point {}", 4 * k + q),
+                        det,
+                        "must be > 0 (inverted or degenerate element)",
+                    ));
+                }
+                out.push(wz[k] * det);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Under finite strain, `∫ ψ(T) dV₀` with the log-space stress (Hencky energy).
+    fn strain_energy(
+        &self,
+        ref_coords: &[Vec3],
+        states: &[PointState],
+        material: &dyn Material,
+    ) -> Result<f64> {
+        let finite = self.finite;
+        self.integrate(ref_coords, states, &|s| {
+            if finite {
+                material.elastic_energy_density(&PointState {
+                    stress: s.log_stress,
+                    ..*s
+                })
+            } else {
+                material.elastic_energy_density(s)
+            }
+        })
+    }
+}
