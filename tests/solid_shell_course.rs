@@ -222,3 +222,26 @@ fn pinched_hemisphere() {
     assert!((uy / 0.094 - 1.0).abs() < 0.02, "{uy}");
 }
 
+
+/// A mesh without through-thickness node columns (built from its nodes and hexahedra)
+/// is refused for the solid-shell with a message naming the cause; so is an element whose
+/// ζ axis does not run up its column (a block with the node order turned on its side).
+#[test]
+fn solid_shell_needs_node_columns() {
+    let block = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 1.0, 0.1), [2, 1, 1]).unwrap();
+    let loose = Mesh::new(block.nodes.clone(), block.hexes.clone()).unwrap();
+    let mut model = Model::new(loose, Arc::new(LinearElastic::new(1.0, 0.0).unwrap())).unwrap();
+    model.settings.element = ElementKind::SolidShell;
+    let err = Simulation::new(model).err().unwrap().to_string();
+    assert!(err.contains("solid_shell") && err.contains("columns"), "{err}");
+    // Turned: ζ along y, so edge 0-4 is not a column step.
+    let mut turned = block.clone();
+    for h in &mut turned.hexes {
+        let [a, b, c, d, e, f, g, k] = *h;
+        *h = [a, e, f, b, d, k, g, c];
+    }
+    let mut model = Model::new(turned, Arc::new(LinearElastic::new(1.0, 0.0).unwrap())).unwrap();
+    model.settings.element = ElementKind::SolidShell;
+    let err = Simulation::new(model).err().unwrap().to_string();
+    assert!(err.contains("element 0") && err.contains("column"), "{err}");
+}
