@@ -12,37 +12,18 @@
 //! solves after the symbolic analysis, wall and process CPU seconds.
 use std::sync::Arc;
 use std::time::Instant;
+use tribo::bench::floor;
 use tribo::solver::linear::{FaerLu, LinearSolver, SymmetricLu};
-use tribo::solver::sparse::{SparseMatrix, SparsePattern};
+use tribo::solver::sparse::SparsePattern;
 use tribo::solver::system_dump;
-
-fn cpu_seconds() -> f64 {
-    // utime + stime of this process, in clock ticks (100 per second on Linux).
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let fields: Vec<&str> = stat
-        .rsplit(')')
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .collect();
-    let tick = |i: usize| {
-        fields
-            .get(i)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (tick(11) + tick(12)) / 100.0
-}
 
 /// Mean wall and CPU milliseconds of `f` over `repeats` calls, after one untimed call.
 fn time(repeats: usize, mut f: impl FnMut()) -> (f64, f64) {
-    f();
-    let (t0, c0) = (Instant::now(), cpu_seconds());
-    for _ in 0..repeats {
+    floor::time_ms(repeats, || {
         f();
-    }
-    let wall = t0.elapsed().as_secs_f64() * 1e3 / repeats as f64;
-    (wall, (cpu_seconds() - c0) * 1e3 / repeats as f64)
+        Ok(())
+    })
+    .expect("infallible")
 }
 
 fn main() {
@@ -132,78 +113,6 @@ fn main() {
     }
 }
 
-/// Mean time of faer's numeric LL^T (after its symbolic analysis) of the SPD matrix with
-/// off-diagonal entries -1 on the pattern of A + A^T and its degree + 1 on the diagonal.
 fn cholesky_floor(p: &SparsePattern, repeats: usize, grouped: bool) -> (f64, f64, usize) {
-    use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::linalg::cholesky::llt::factor::LltRegularization;
-    use faer::sparse::linalg::cholesky::{
-        factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
-    };
-    use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-    use faer::{Par, Side};
-    let n = p.n;
-    let lower = SparsePattern::from_entries(
-        n,
-        (0..n)
-            .flat_map(|c| {
-                p.row_idx[p.col_ptr[c]..p.col_ptr[c + 1]]
-                    .iter()
-                    .map(move |&r| (r.max(c), r.min(c)))
-            })
-            .chain((0..n).map(|i| (i, i))),
-    );
-    let mut m = SparseMatrix::zeros(Arc::new(lower.clone()));
-    let mut degree = vec![0.0; n];
-    for c in 0..n {
-        for k in lower.col_ptr[c]..lower.col_ptr[c + 1] {
-            let r = lower.row_idx[k];
-            if r != c {
-                m.values[k] = -1.0;
-                degree[r] += 1.0;
-                degree[c] += 1.0;
-            }
-        }
-    }
-    for (c, d) in degree.iter().enumerate() {
-        let k = lower.position(c, c).unwrap();
-        m.values[k] = d + 1.0;
-    }
-    let sym = SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
-    let order = match (&p.groups, grouped) {
-        (Some(groups), true) => {
-            Some(tribo::solver::symmetric_lu::grouped_order(&lower, groups).unwrap())
-        }
-        _ => None,
-    };
-    let ordering = match &order {
-        Some((fwd, inv)) => {
-            SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, n))
-        }
-        None => SymmetricOrdering::Amd,
-    };
-    let symbolic = factorize_symbolic_cholesky(
-        sym,
-        Side::Lower,
-        ordering,
-        CholeskySymbolicParams::default(),
-    )
-    .unwrap();
-    let mut l_values = vec![0.0; symbolic.len_val()];
-    let mut buffer =
-        MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
-    let (wall, cpu) = time(repeats, || {
-        symbolic
-            .factorize_numeric_llt(
-                &mut l_values,
-                SparseColMatRef::new(sym, &m.values),
-                Side::Lower,
-                LltRegularization::default(),
-                Par::Seq,
-                MemStack::new(&mut buffer),
-                Default::default(),
-            )
-            .unwrap();
-    });
-    (wall, cpu, symbolic.len_val())
+    floor::cholesky_floor(p, repeats, grouped).unwrap()
 }

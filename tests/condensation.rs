@@ -4,6 +4,7 @@
 mod common;
 
 use tribo::solver::linear::{FaerLu, LinearSolverKind, SymmetricLu};
+use tribo::contact::ContactStatus;
 use tribo::solver::Simulation;
 
 fn drag(eliminate: bool) -> Simulation {
@@ -44,8 +45,12 @@ fn slot_plan_builds_the_reduced_system_of_the_search() {
     let x = sim.unknowns().to_vec();
     let e = sim.evaluate_at(t_new, &x).unwrap();
     let condenser = sim.condenser().expect("multipliers are eliminated");
-    let (a, rhs) = condenser.reduced_system(&e.jacobian, &e.residual);
-    let (a_ref, rhs_ref) = condenser.reduced_system_by_search(&e.jacobian, &e.residual);
+    let (a, rhs) = condenser
+        .reduced_system(&e.jacobian, &e.residual)
+        .expect("no node has two active pairs");
+    let (a_ref, rhs_ref) = condenser
+        .reduced_system_by_search(&e.jacobian, &e.residual)
+        .expect("no node has two active pairs");
     assert!(a.values.iter().any(|v| *v != 0.0));
     assert_eq!(a.pattern, a_ref.pattern);
     for (k, (v, w)) in a.values.iter().zip(&a_ref.values).enumerate() {
@@ -143,4 +148,124 @@ fn symmetric_lu_and_pivoting_lu_runs_agree() {
     println!("max difference {d:.2e} of {scale:.2e}");
     assert_eq!(iters(&a), iters(&b));
     assert!(d < 1e-9 * scale, "runs differ by {d}");
+}
+
+/// The free drag with a second roller on the same face, 6 ahead of the first: every top
+/// node is a candidate of both tools (two pairs, like the cup's top face under punch and
+/// holder), and all their multipliers are eliminated.
+fn two_roller_drag(eliminate: bool) -> Simulation {
+    use tribo::geometry::{Cylinder, Vec3};
+    let mut model = common::cylinder_drag_model(16.0, 4.0, 32, 3.0);
+    model.settings.increments = 12;
+    model.dirichlet.retain(|d| !d.label.starts_with('y'));
+    let axis = Vec3::new(10.0, 0.0, 4.0 + 5.0 + 0.02);
+    let cyl = Cylinder::new(axis, Vec3::y(), 5.0).unwrap();
+    let path = [
+        (0.0, [0.0; 3]),
+        (1.0, [0.0, 0.0, -0.12]),
+        (3.0, [3.0, 0.0, -0.12]),
+    ];
+    model
+        .add_tool(common::tool("second roller", cyl, &path, 0.3), "z+", None)
+        .unwrap();
+    model.settings.eliminate_multipliers = eliminate;
+    Simulation::new(model).unwrap()
+}
+
+/// Nodes with two pairs: the local elimination (one pair active, the other in gap, or both
+/// in gap) gives the mixed system's Newton step, in every iterate of pressing and dragging.
+#[test]
+fn two_pair_nodes_condense_to_the_mixed_step() {
+    let mut sim = two_roller_drag(true);
+    let n_lambda = sim.unknowns().len() - 3 * (33 * 2 * 9);
+    assert_eq!(sim.eliminated_multipliers(), n_lambda, "displacement-only system");
+    let mut worst = 0.0f64;
+    let mut active_per_tool = [0usize; 2];
+    for steps in [2, 3, 3] {
+        for _ in 0..steps {
+            sim.step().unwrap();
+        }
+        let t_new = sim.time() + 0.25;
+        let mut x = sim.unknowns().to_vec();
+        for _ in 0..3 {
+            let e = sim.evaluate_at(t_new, &x).unwrap();
+            for (count, tool) in active_per_tool.iter_mut().zip(&e.nodal) {
+                *count += tool
+                    .iter()
+                    .filter(|(n, _)| n.status != ContactStatus::Gap)
+                    .count();
+            }
+            let (_, condensed, scale, diff) = common::full_and_condensed_steps(&sim, &e);
+            println!("t {t_new}: step {scale:.3e}, difference {diff:.3e}");
+            // One system, two eliminations: round-off times the condition number.
+            assert!(diff < 1e-10 * scale, "condensed step differs by {diff:e}");
+            worst = worst.max(diff / scale);
+            for (xi, d) in x.iter_mut().zip(&condensed) {
+                *xi += d;
+            }
+        }
+    }
+    // Each roller's pair is the active one at some nodes (and in gap at the others).
+    assert!(active_per_tool.iter().all(|&c| c > 0), "{active_per_tool:?}");
+    let condenser = sim.condenser().unwrap();
+    assert_eq!(condenser.fallback_count(), 0, "no node had two active pairs");
+    println!("worst relative difference {worst:.2e}");
+}
+
+/// Whole runs with two rollers: the same iterations, the same converged unknowns up to
+/// Newton's tolerance, with and without the elimination.
+#[test]
+fn two_pair_condensed_and_mixed_runs_agree() {
+    let mut a = two_roller_drag(true);
+    let mut b = two_roller_drag(false);
+    a.run(|_, _| Ok(())).unwrap();
+    b.run(|_, _| Ok(())).unwrap();
+    let scale = b.unknowns().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let d = a
+        .unknowns()
+        .iter()
+        .zip(b.unknowns())
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let iters = |s: &Simulation| s.history.iter().map(|r| r.iterations).collect::<Vec<_>>();
+    println!("max difference {d:.2e} of {scale:.2e}; iterations {:?}", iters(&a));
+    assert_eq!(iters(&a), iters(&b));
+    assert!(d < 1e-9 * scale, "runs differ by {d}");
+}
+
+/// A node with both pairs active (here: both sliding without friction, normals z and x)
+/// has no local elimination: that call solves the mixed system instead, with the same
+/// step.
+#[test]
+fn two_active_pairs_fall_back_to_the_mixed_solve() {
+    let mut sim = two_roller_drag(true);
+    sim.step().unwrap();
+    sim.step().unwrap();
+    let x = sim.unknowns().to_vec();
+    let mut e = sim.evaluate_at(sim.time() + 0.25, &x).unwrap();
+    let (model, n_u) = (&sim.model, 3 * sim.model.mesh.nodes.len());
+    let k = model.contacts[0].candidates.len() / 2;
+    let node = model.contacts[0].candidates[k];
+    assert_eq!(model.contacts[1].candidates[k], node);
+    let j = &mut e.jacobian;
+    for (c, normal) in [(0, 2), (1, 0)] {
+        let l = n_u + 3 * c * model.contacts[0].candidates.len() + 3 * k;
+        let r = model.contacts[c].r[k];
+        for a in 0..3 {
+            for b in 0..3 {
+                let nn = if a == normal && b == normal { 1.0 } else { 0.0 };
+                let mut set = |row: usize, col: usize, v: f64| {
+                    let p = j.pattern.position(row, col).expect("pair block entry");
+                    j.values[p] = v;
+                };
+                set(3 * node + a, l + b, nn);
+                set(l + a, l + b, (nn - f64::from(u8::from(a == b))) / r);
+                set(l + a, 3 * node + b, nn);
+            }
+        }
+    }
+    let before = sim.condenser().unwrap().fallback_count();
+    let (_, _, scale, diff) = common::full_and_condensed_steps(&sim, &e);
+    assert_eq!(sim.condenser().unwrap().fallback_count(), before + 1);
+    println!("step {scale:.3e}, difference {diff:.3e}");
+    assert!(diff < 1e-10 * scale, "steps differ by {diff:e}");
 }

@@ -10,6 +10,8 @@
 //! `/proc/self/stat` before and after waiting for it, 1/100 s resolution), wall seconds the
 //! parent's clock around the child. The numbers are reported, never judged.
 
+pub mod floor;
+
 use crate::{Error, Result};
 use serde::Serialize;
 use std::collections::BTreeMap;

@@ -1,32 +1,50 @@
 //! Node-by-node elimination of the contact multipliers from the mixed Newton system.
 //!
-//! For a contact node `a` with a single (tool, node) pair, multiplier block `l`, augmentation
-//! `r`, the two block rows of the mixed system are
+//! A contact node `a` with pairs `p = 1..m` (one per tool that may touch it), multiplier
+//! blocks `l_p`, augmentations `r_p`, has `3 + 3m` local rows: its equilibrium and its
+//! pairs' multiplier rows,
 //!
 //! ```text
-//! R1 (equilibrium of a):  K_a du + E_x du_a + E_l dl = -R_u,a
-//! R2 (multiplier):        S_x du_a + S_l dl          = -R_l,      S_x = E_x / r,  S_l = (E_l - I) / r
+//! R1   (equilibrium of a):  K_a du + sum_p (E_x,p du_a + E_l,p dl_p) = -R_u,a
+//! R2_p (multiplier of p):   S_x,p du_a + S_l,p dl_p                  = -R_l,p
+//!                           S_x,p = E_x,p / r_p,  S_l,p = (E_l,p - I) / r_p
 //! ```
 //!
-//! `R1 - r R2` reads `K_a du + dl = -R_u,a + r R_l`: the multiplier increment follows from
-//! the displacements, `dl = (-R_u,a + r R_l) - K_a du`, whatever the contact status (the
-//! identity never degenerates). Put into `r R2`, with `M = I - E_l`:
+//! With `M_p = I - E_l,p` (I in gap, singular once the pair is active: 0 in stick, the
+//! normal direction removed in slip), two combinations of the local rows never degenerate:
 //!
 //! ```text
-//! (E_x e_a + M K_a) du = -r R_l + M (-R_u,a + r R_l)
+//! Sigma = R1 - sum_p r_p R2_p:   K_a du + sum_p dl_p = ...     (the multipliers' sum)
+//! W_p   = r_p R2_p:              E_x,p du_a - M_p dl_p = ...   (pair p's own row)
 //! ```
 //!
-//! which replaces node a's equilibrium rows; its pattern is K's row pattern. (In gap M = I
-//! and the row is plain equilibrium; in stick M = 0 and it is the kinematic constraint.)
-//! The reduced system has the displacement unknowns plus the multipliers that stay: pairs
-//! at nodes with a prescribed component or with several pairs (a node that two tools may
-//! touch).
+//! Let `q` be the pair with the most singular `M_q` (the active one) and every other `M_p`
+//! invertible (those pairs are in gap). Then `dl_p = -M_p^-1 W_p` for `p != q`,
+//! `dl_q = Sigma - sum_{p != q} dl_p`, and `W_q + M_q dl_q` is free of multipliers: it
+//! replaces node a's equilibrium rows,
+//!
+//! ```text
+//! P = W_q + M_q (Sigma + sum_{p != q} M_p^-1 W_p)      (3 rows, pattern of K's row)
+//! ```
+//!
+//! For one pair, `P = M R1 + r E_l R2`: plain equilibrium in gap (M = I), the kinematic
+//! constraint `E_x du_a` in stick (M = 0); for a top-face node of the cup (punch and holder
+//! pairs) at most one of which touches, it is the active pair's row, or plain equilibrium
+//! when neither does. The coefficients, `C = [P; H]` with `dl = H (rhs - N du)` (`N` the
+//! local rows' other columns), form one `(3 + 3m)^2` matrix per node and iteration; the
+//! reduced system is displacement-only with the symmetric structure of the stiffness, so a
+//! factorization on that structure fills like a Cholesky. Two pairs of one node active at
+//! once (no `q` exists) is not reduced: that call solves the mixed system instead
+//! ([`Condenser::fallback_count`]).
+//!
+//! Nodes with a prescribed component keep their multipliers (their equilibrium row is a
+//! unit row, so `Sigma` does not exist), as do their pairs: the reduced system then has the
+//! displacements plus those few multipliers.
 //!
 //! A force-controlled tool adds an offset unknown `s` (see `force_control`): its column
-//! enters R1 as `E_s ds` and R2 as `(E_s / r) ds`, which cancel in `R1 - r R2`, so `dl`
-//! keeps the form above and node a's condensed row gains `E_s ds`. The tool's force row
-//! `sum_k c_k . dl_k = -R_s` is kept, with `dl_k` substituted: it gains `-c_k K_k` on the
-//! displacement columns around each eliminated node k.
+//! enters the local rows and so the condensed rows; the tool's force row
+//! `sum_k c_k . dl_k = -R_s` is kept, with `dl_k = H_k (rhs - N du)` substituted (the
+//! columns of node k's equilibrium row).
 //!
 //! Cost: O(nnz) per iteration to build, by a slot plan recorded once per pattern (the value
 //! index of every contribution, in a fixed order), so that no entry is searched for; the
@@ -37,6 +55,7 @@ use super::linear::LinearSolver;
 use super::model::Model;
 use super::sparse::{SparseMatrix, SparsePattern};
 use crate::Result;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// Elimination groups of the mixed unknowns (see `SparsePattern::groups`): a node's
@@ -60,38 +79,96 @@ pub fn elimination_groups(model: &Model, dofs: &DofMap) -> Vec<usize> {
     groups
 }
 
-/// A pair whose multiplier is eliminated.
+/// A pair of an eliminated node.
 #[derive(Clone, Debug)]
-struct Eliminated {
-    node: usize,
+struct Pair {
+    /// First multiplier unknown.
     lambda: usize,
+    /// Augmentation parameter.
     r: f64,
+    /// Position in J of E_l = (u_a + alpha, lambda + beta).
+    e_l_position: [[Option<usize>; 3]; 3],
 }
+
+/// A node whose multipliers are all eliminated.
+#[derive(Clone, Debug)]
+struct EliminatedNode {
+    node: usize,
+    pairs: Vec<Pair>,
+    /// Offset of its coefficient matrix `C = [P; H]` (`width^2` values, row-major) in the
+    /// per-iteration coefficient buffer.
+    offset: usize,
+}
+
+impl EliminatedNode {
+    /// Number of local rows (and columns of C): equilibrium, then each pair's multipliers.
+    fn width(&self) -> usize {
+        3 + 3 * self.pairs.len()
+    }
+
+    /// Full row index of local row `i`.
+    fn local_row(&self, i: usize) -> usize {
+        if i < 3 {
+            3 * self.node + i
+        } else {
+            self.pairs[(i - 3) / 3].lambda + (i - 3) % 3
+        }
+    }
+}
+
+/// The local elimination of a node with two active pairs does not exist.
+#[derive(Debug)]
+struct NoLocalElimination;
 
 /// The static reduction of a model's mixed system (which multipliers go, where the rest
 /// land), built once per model.
 #[derive(Debug)]
 pub struct Condenser {
-    eliminated: Vec<Eliminated>,
+    nodes: Vec<EliminatedNode>,
+    /// Length of the coefficient buffer (sum of the nodes' `width^2`).
+    coefficient_count: usize,
     /// Full dof -> reduced dof (None: eliminated multiplier).
     reduced_index: Vec<Option<usize>>,
     /// Pattern of the reduced matrix.
     pattern: Arc<SparsePattern>,
     /// Row-wise view of the full pattern: for each row, (column, value position).
     rows: Vec<Vec<(usize, usize)>>,
-    /// Rows of eliminated nodes' equilibrium equations (full index), to skip when copying.
+    /// Rows of eliminated nodes' local blocks (full index), to skip when copying.
     condensed_row: Vec<bool>,
-    /// Eliminated multiplier dof -> (index in `eliminated`, component).
+    /// Eliminated multiplier dof -> (index in `nodes`, row of C that recovers it).
     owner: Vec<Option<(usize, usize)>>,
-    /// Number of displacement unknowns (they come first).
-    n_u: usize,
-    /// Per eliminated pair, position in J of E_l = (u_a + alpha, lambda + beta).
-    e_l_position: Vec<[[Option<usize>; 3]; 3]>,
-    /// Per eliminated pair, position in J of the contact block (lambda + beta, u_a + g).
-    e_x_position: Vec<[[Option<usize>; 3]; 3]>,
     /// The slot plan: the reduced matrix's value index of every contribution, in the order
     /// of [`Self::walk`] (u32: the reduced pattern has fewer than 2^32 entries).
     slots: Vec<u32>,
+    /// Calls solved through the mixed system because no local elimination existed.
+    fallbacks: AtomicUsize,
+}
+
+/// With this variable set, nodes with several pairs keep their multipliers (the reduction
+/// before two-pair nodes were eliminated): for before/after benchmarks of the factorization
+/// only (BENCHMARKS.md); the answers are the same either way.
+pub const SINGLE_PAIR_VARIABLE: &str = "TRIBO_CONDENSE_SINGLE_PAIR";
+
+/// |det M| under which a gap pair's `M_p` counts as singular (M is I in gap, exactly
+/// singular once active: the entries are O(1) and dimensionless).
+const SINGULAR_DET: f64 = 1e-6;
+
+fn det3(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+fn inverse3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let d = det3(m);
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            // Cofactor (j, i) over the determinant.
+            let (r0, r1) = ((j + 1) % 3, (j + 2) % 3);
+            let (c0, c1) = ((i + 1) % 3, (i + 2) % 3);
+            (m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]) / d
+        })
+    })
 }
 
 impl Condenser {
@@ -102,40 +179,54 @@ impl Condenser {
         full: &SparsePattern,
         is_fixed: &[bool],
     ) -> Option<Self> {
-        let n_u = 3 * dofs.n_nodes;
-        let mut pairs_at_node = vec![0usize; dofs.n_nodes];
-        for c in &model.contacts {
-            for &node in &c.candidates {
-                pairs_at_node[node] += 1;
-            }
-        }
-        let mut eliminated = Vec::new();
+        let mut pairs_at: Vec<Vec<(usize, f64)>> = vec![Vec::new(); dofs.n_nodes];
         for (c, contact) in model.contacts.iter().enumerate() {
             let Some(off) = dofs.lambda_offset[c] else {
                 continue;
             };
             for (k, &node) in contact.candidates.iter().enumerate() {
-                let free = (0..3).all(|i| !is_fixed[3 * node + i]);
-                if pairs_at_node[node] == 1 && free {
-                    eliminated.push(Eliminated {
-                        node,
-                        lambda: off + 3 * k,
-                        r: contact.r[k],
-                    });
-                }
+                pairs_at[node].push((off + 3 * k, contact.r[k]));
             }
         }
-        if eliminated.is_empty() {
+        let single_pair_only = std::env::var_os(SINGLE_PAIR_VARIABLE).is_some();
+        let mut nodes = Vec::new();
+        let mut coefficient_count = 0;
+        for (node, pairs) in pairs_at.into_iter().enumerate() {
+            let free = (0..3).all(|i| !is_fixed[3 * node + i]);
+            if pairs.is_empty() || !free || (single_pair_only && pairs.len() > 1) {
+                continue;
+            }
+            let pairs: Vec<Pair> = pairs
+                .into_iter()
+                .map(|(lambda, r)| Pair {
+                    lambda,
+                    r,
+                    e_l_position: std::array::from_fn(|a| {
+                        std::array::from_fn(|b| full.position(3 * node + a, lambda + b))
+                    }),
+                })
+                .collect();
+            let e = EliminatedNode {
+                node,
+                pairs,
+                offset: coefficient_count,
+            };
+            coefficient_count += e.width() * e.width();
+            nodes.push(e);
+        }
+        if nodes.is_empty() {
             return None;
         }
         let mut gone = vec![false; full.n];
         let mut condensed_row = vec![false; full.n];
         let mut owner = vec![None; full.n];
-        for (index, e) in eliminated.iter().enumerate() {
-            for i in 0..3 {
-                gone[e.lambda + i] = true;
-                owner[e.lambda + i] = Some((index, i));
-                condensed_row[3 * e.node + i] = true;
+        for (index, e) in nodes.iter().enumerate() {
+            for i in 0..e.width() {
+                condensed_row[e.local_row(i)] = true;
+                if i >= 3 {
+                    gone[e.local_row(i)] = true;
+                    owner[e.local_row(i)] = Some((index, i));
+                }
             }
         }
         let mut reduced_index = vec![None; full.n];
@@ -157,35 +248,32 @@ impl Condenser {
                 }
             }
         }
-        // A kept row with an eliminated column (the force row of a force-controlled tool)
-        // receives the substitution dl = rhs1 - K_a du: the pattern of K_a's row.
+        // The condensed rows combine the node's local rows, and a kept row with an
+        // eliminated column (the force row of a force-controlled tool) receives the
+        // substitution of that multiplier: both take the local rows' reduced columns.
+        let local_columns = |e: &EliminatedNode| -> Vec<usize> {
+            (0..e.width())
+                .flat_map(|i| rows[e.local_row(i)].iter())
+                .filter_map(|&(col, _)| reduced_index[col])
+                .collect()
+        };
+        for e in &nodes {
+            let columns = local_columns(e);
+            for alpha in 0..3 {
+                let ri = reduced_index[3 * e.node + alpha].expect("displacements stay");
+                entries.extend(columns.iter().map(|&ci| (ri, ci)));
+            }
+        }
         for (r, row) in rows.iter().enumerate() {
             let (Some(ri), false) = (reduced_index[r], condensed_row[r]) else {
                 continue;
             };
             for &(c, _) in row {
-                if let Some((index, beta)) = owner[c] {
-                    for &(col, _) in &rows[3 * eliminated[index].node + beta] {
-                        if let Some(ci) = reduced_index[col] {
-                            entries.push((ri, ci));
-                        }
-                    }
+                if let Some((index, _)) = owner[c] {
+                    entries.extend(local_columns(&nodes[index]).into_iter().map(|ci| (ri, ci)));
                 }
             }
         }
-        let positions = |row: &dyn Fn(&Eliminated, usize) -> usize,
-                         col: &dyn Fn(&Eliminated, usize) -> usize| {
-            eliminated
-                .iter()
-                .map(|e| {
-                    std::array::from_fn(|a| {
-                        std::array::from_fn(|b| full.position(row(e, a), col(e, b)))
-                    })
-                })
-                .collect::<Vec<[[Option<usize>; 3]; 3]>>()
-        };
-        let e_l_position = positions(&|e, a| 3 * e.node + a, &|e, b| e.lambda + b);
-        let e_x_position = positions(&|e, a| e.lambda + a, &|e, b| 3 * e.node + b);
         let full_groups = elimination_groups(model, dofs);
         let mut groups = vec![0; next];
         for (d, ri) in reduced_index.iter().enumerate() {
@@ -198,56 +286,134 @@ impl Condenser {
             return None;
         }
         let mut condenser = Condenser {
-            owner,
-            n_u,
-            eliminated,
+            nodes,
+            coefficient_count,
             reduced_index,
             pattern,
             rows,
             condensed_row,
-            e_l_position,
-            e_x_position,
+            owner,
             slots: Vec::new(),
+            fallbacks: AtomicUsize::new(0),
         };
         // Record the plan: the walk only depends on the pattern, so zero values will do.
         let zeros = vec![0.0; full.nnz()];
+        let coefficients = condenser
+            .coefficients(&zeros)
+            .expect("with a zero Jacobian every pair is in gap");
         let mut rhs = vec![0.0; next];
         let mut slots = Vec::new();
         let reduced = condenser.pattern.clone();
-        condenser.walk(&zeros, &vec![0.0; full.n], &mut rhs, |r, c, _| {
-            let k = reduced
-                .position(r, c)
-                .expect("the reduced pattern holds every contribution");
-            slots.push(k as u32);
-        });
+        condenser.walk(
+            &coefficients,
+            &zeros,
+            &vec![0.0; full.n],
+            &mut rhs,
+            |r, c, _| {
+                let k = reduced
+                    .position(r, c)
+                    .expect("the reduced pattern holds every contribution");
+                slots.push(k as u32);
+            },
+        );
         condenser.slots = slots;
         Some(condenser)
     }
 
+    /// Number of eliminated multiplier unknowns.
     pub fn eliminated_count(&self) -> usize {
-        3 * self.eliminated.len()
+        self.nodes.iter().map(|e| 3 * e.pairs.len()).sum()
     }
 
-    /// Adds `factor * K_a[beta]` to reduced row `ri`: K_a is the equilibrium row of the
-    /// eliminated node minus r times its multiplier row (which removes the contact block
-    /// E_x and a tool offset's column E_s, leaving the element stiffness).
-    fn add_k_row(
+    /// Number of solves that went through the mixed system because a node had two active
+    /// pairs (no local elimination).
+    pub fn fallback_count(&self) -> usize {
+        self.fallbacks.load(Ordering::Relaxed)
+    }
+
+    /// The reduced system's pattern (displacements, tool offsets and kept multipliers).
+    pub fn pattern(&self) -> &Arc<SparsePattern> {
+        &self.pattern
+    }
+
+    /// Every node's coefficient matrix `C = [P; H]` (module doc) from the Jacobian values:
+    /// rows 0..3 combine the local rows into the condensed rows, row `3 + 3p + beta`
+    /// recovers pair p's multiplier component beta. O(m^2) per node.
+    fn coefficients(&self, j: &[f64]) -> std::result::Result<Vec<f64>, NoLocalElimination> {
+        let mut out = vec![0.0; self.coefficient_count];
+        for e in &self.nodes {
+            let w = e.width();
+            let c = &mut out[e.offset..e.offset + w * w];
+            let m: Vec<[[f64; 3]; 3]> = e
+                .pairs
+                .iter()
+                .map(|p| {
+                    std::array::from_fn(|a| {
+                        std::array::from_fn(|b| {
+                            let e_l = p.e_l_position[a][b].map_or(0.0, |k| j[k]);
+                            f64::from(u8::from(a == b)) - e_l
+                        })
+                    })
+                })
+                .collect();
+            let dets: Vec<f64> = m.iter().map(|mp| det3(mp).abs()).collect();
+            let q = (0..m.len())
+                .min_by(|&a, &b| dets[a].total_cmp(&dets[b]))
+                .expect("an eliminated node has a pair");
+            // H_q starts as Sigma (rows 3 + 3q ..).
+            let hq = 3 + 3 * q;
+            for alpha in 0..3 {
+                c[(hq + alpha) * w + alpha] = 1.0;
+                for (p, pair) in e.pairs.iter().enumerate() {
+                    c[(hq + alpha) * w + 3 + 3 * p + alpha] = -pair.r;
+                }
+            }
+            for (p, pair) in e.pairs.iter().enumerate() {
+                if p == q {
+                    continue;
+                }
+                if dets[p] <= SINGULAR_DET {
+                    return Err(NoLocalElimination);
+                }
+                // H_p = -M_p^-1 W_p, and H_q -= H_p.
+                let inv = inverse3(&m[p]);
+                for alpha in 0..3 {
+                    for beta in 0..3 {
+                        let v = -inv[alpha][beta] * pair.r;
+                        c[(3 + 3 * p + alpha) * w + 3 + 3 * p + beta] = v;
+                        c[(hq + alpha) * w + 3 + 3 * p + beta] -= v;
+                    }
+                }
+            }
+            // P = W_q + M_q H_q.
+            let r_q = e.pairs[q].r;
+            for alpha in 0..3 {
+                for i in 0..w {
+                    let mut v: f64 = (0..3).map(|b| m[q][alpha][b] * c[(hq + b) * w + i]).sum();
+                    if i == hq + alpha {
+                        v += r_q;
+                    }
+                    c[alpha * w + i] = v;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Adds `factor` times the reduced columns of node `e`'s local row `i` to reduced row
+    /// `ri`.
+    fn add_local_row(
         &self,
         emit: &mut impl FnMut(usize, usize, f64),
         j: &[f64],
         ri: usize,
-        e: &Eliminated,
-        beta: usize,
+        e: &EliminatedNode,
+        i: usize,
         factor: f64,
     ) {
-        for &(col, k) in &self.rows[3 * e.node + beta] {
+        for &(col, k) in &self.rows[e.local_row(i)] {
             if let Some(ci) = self.reduced_index[col] {
                 emit(ri, ci, factor * j[k]);
-            }
-        }
-        for &(col, k) in &self.rows[e.lambda + beta] {
-            if let Some(ci) = self.reduced_index[col] {
-                emit(ri, ci, -factor * e.r * j[k]);
             }
         }
     }
@@ -257,6 +423,7 @@ impl Condenser {
     /// side. The slot plan is this walk recorded once; the numeric pass replays it.
     fn walk(
         &self,
+        coefficients: &[f64],
         j: &[f64],
         residual: &[f64],
         rhs: &mut [f64],
@@ -275,50 +442,54 @@ impl Condenser {
             for &(col, k) in &self.rows[row] {
                 if let Some(ci) = self.reduced_index[col] {
                     emit(ri, ci, j[k]);
-                } else if let Some((index, beta)) = self.owner[col] {
-                    // c dl_beta with dl_beta = rhs1_beta - K_a[beta] du.
-                    let e = &self.eliminated[index];
-                    let (ua, l, c) = (3 * e.node, e.lambda, j[k]);
-                    rhs[ri] -= c * (-residual[ua + beta] + e.r * residual[l + beta]);
-                    self.add_k_row(&mut emit, j, ri, e, beta, -c);
+                } else if let Some((index, h_row)) = self.owner[col] {
+                    // c dl with dl = H (rhs_local - N du).
+                    let e = &self.nodes[index];
+                    let w = e.width();
+                    let h = &coefficients[e.offset + h_row * w..e.offset + (h_row + 1) * w];
+                    for (i, &h_i) in h.iter().enumerate() {
+                        rhs[ri] += j[k] * h_i * residual[e.local_row(i)];
+                        self.add_local_row(&mut emit, j, ri, e, i, -j[k] * h_i);
+                    }
                 }
             }
         }
-        // Condensed rows: (E_x e_a + M K_a) du + E_s ds = -r R_l + M (-R_u,a + r R_l).
-        for (index, e) in self.eliminated.iter().enumerate() {
-            let (ua, l, r) = (3 * e.node, e.lambda, e.r);
-            let mut m = [[0.0; 3]; 3];
-            for (alpha, m_row) in m.iter_mut().enumerate() {
-                for (beta, m_ab) in m_row.iter_mut().enumerate() {
-                    let e_l = self.e_l_position[index][alpha][beta].map_or(0.0, |k| j[k]);
-                    *m_ab = f64::from(u8::from(alpha == beta)) - e_l;
-                }
-            }
-            let rhs1: [f64; 3] = std::array::from_fn(|b| -residual[ua + b] + r * residual[l + b]);
+        // Condensed rows: P N du = P rhs_local.
+        for e in &self.nodes {
+            let w = e.width();
             for alpha in 0..3 {
-                let ri = self.reduced_index[ua + alpha].expect("displacements stay");
-                rhs[ri] =
-                    -r * residual[l + alpha] + (0..3).map(|b| m[alpha][b] * rhs1[b]).sum::<f64>();
-                for (beta, &m_ab) in m[alpha].iter().enumerate() {
-                    self.add_k_row(&mut emit, j, ri, e, beta, m_ab);
-                }
-                // r S: E_x on the node's own displacements (and E_s on a tool offset).
-                for &(col, k) in &self.rows[l + alpha] {
-                    if let Some(ci) = self.reduced_index[col] {
-                        emit(ri, ci, r * j[k]);
-                    }
+                let ri = self.reduced_index[3 * e.node + alpha].expect("displacements stay");
+                let p = &coefficients[e.offset + alpha * w..e.offset + (alpha + 1) * w];
+                rhs[ri] = -(0..w).map(|i| p[i] * residual[e.local_row(i)]).sum::<f64>();
+                for (i, &p_i) in p.iter().enumerate() {
+                    self.add_local_row(&mut emit, j, ri, e, i, p_i);
                 }
             }
         }
     }
 
     /// The reduced matrix and right-hand side, built by replaying the slot plan: one linear
-    /// pass over the contributions, no search. O(contributions) = O(nnz(J)) per call.
-    pub fn reduced_system(&self, j: &SparseMatrix, residual: &[f64]) -> (SparseMatrix, Vec<f64>) {
+    /// pass over the contributions, no search. O(contributions) = O(nnz(J)) per call. `None`
+    /// when a node has two active pairs (no local elimination).
+    pub fn reduced_system(
+        &self,
+        j: &SparseMatrix,
+        residual: &[f64],
+    ) -> Option<(SparseMatrix, Vec<f64>)> {
+        let coefficients = self.coefficients(&j.values).ok()?;
+        Some(self.reduced_with(&coefficients, j, residual))
+    }
+
+    fn reduced_with(
+        &self,
+        coefficients: &[f64],
+        j: &SparseMatrix,
+        residual: &[f64],
+    ) -> (SparseMatrix, Vec<f64>) {
         let mut a = SparseMatrix::zeros(self.pattern.clone());
         let mut rhs = vec![0.0; self.pattern.n];
         let mut slots = self.slots.iter();
-        self.walk(&j.values, residual, &mut rhs, |_, _, v| {
+        self.walk(coefficients, &j.values, residual, &mut rhs, |_, _, v| {
             let k = *slots.next().expect("the plan covers every contribution");
             a.values[k as usize] += v;
         });
@@ -333,16 +504,20 @@ impl Condenser {
         &self,
         j: &SparseMatrix,
         residual: &[f64],
-    ) -> (SparseMatrix, Vec<f64>) {
+    ) -> Option<(SparseMatrix, Vec<f64>)> {
+        let coefficients = self.coefficients(&j.values).ok()?;
         let mut a = SparseMatrix::zeros(self.pattern.clone());
         let mut rhs = vec![0.0; self.pattern.n];
-        self.walk(&j.values, residual, &mut rhs, |r, c, v| a.add(r, c, v));
-        (a, rhs)
+        self.walk(&coefficients, &j.values, residual, &mut rhs, |r, c, v| {
+            a.add(r, c, v)
+        });
+        Some((a, rhs))
     }
 
     /// Solves `J dx = -residual` through the reduced system; returns the full dx. The
     /// unknowns `border` (full indices, never eliminated multipliers) are solved by the
-    /// linear solver's Schur complement.
+    /// linear solver's Schur complement. A node with two active pairs makes this call solve
+    /// the mixed system with the same solver.
     pub fn solve(
         &self,
         j: &SparseMatrix,
@@ -351,7 +526,13 @@ impl Condenser {
         linear: &mut dyn LinearSolver,
     ) -> Result<Vec<f64>> {
         let n = j.pattern.n;
-        let (a, mut rhs) = self.reduced_system(j, residual);
+        let Ok(coefficients) = self.coefficients(&j.values) else {
+            self.fallbacks.fetch_add(1, Ordering::Relaxed);
+            let mut dx: Vec<f64> = residual.iter().map(|v| -v).collect();
+            linear.solve_bordered(j, &mut dx, border)?;
+            return Ok(dx);
+        };
+        let (a, mut rhs) = self.reduced_with(&coefficients, j, residual);
         let reduced_border: Vec<usize> = border
             .iter()
             .filter_map(|&d| self.reduced_index[d])
@@ -363,22 +544,26 @@ impl Condenser {
                 dx[d] = rhs[*ri];
             }
         }
-        // Back-substitution: dl = (-R_u,a + r R_l) - K_a du.
-        for (index, e) in self.eliminated.iter().enumerate() {
-            let (ua, l, r) = (3 * e.node, e.lambda, e.r);
-            for beta in 0..3 {
-                let mut k_du = 0.0;
-                for &(col, k) in &self.rows[ua + beta] {
-                    if col < self.n_u {
-                        k_du += j.values[k] * dx[col];
-                    }
+        // Back-substitution: dl = H (rhs_local - N du), N over the reduced columns.
+        let mut t = Vec::new();
+        for e in &self.nodes {
+            let w = e.width();
+            t.clear();
+            t.extend((0..w).map(|i| {
+                let row = e.local_row(i);
+                let n_du: f64 = self.rows[row]
+                    .iter()
+                    .filter(|&&(col, _)| self.reduced_index[col].is_some())
+                    .map(|&(col, k)| j.values[k] * dx[col])
+                    .sum();
+                -residual[row] - n_du
+            }));
+            let c = &coefficients[e.offset..e.offset + w * w];
+            for (p, pair) in e.pairs.iter().enumerate() {
+                for beta in 0..3 {
+                    let h = &c[(3 + 3 * p + beta) * w..(4 + 3 * p + beta) * w];
+                    dx[pair.lambda + beta] = h.iter().zip(&t).map(|(a, b)| a * b).sum();
                 }
-                // Remove the contact block's own contribution E_x du_a.
-                for g in 0..3 {
-                    let e_x = self.e_x_position[index][beta][g].map_or(0.0, |k| j.values[k]);
-                    k_du -= r * e_x * dx[ua + g];
-                }
-                dx[l + beta] = -residual[ua + beta] + r * residual[l + beta] - k_du;
             }
         }
         Ok(dx)

@@ -1,7 +1,8 @@
 //! Writes and reads a linear system (matrix, right-hand side, border unknowns) in a small
 //! binary format, so that a solver can be benchmarked on the systems of a real run: with
 //! `TRIBO_DUMP_SYSTEM=PATH` in the environment, every solve of the default solver
-//! overwrites PATH with its system (diagnostics only; costs a file write per solve).
+//! overwrites PATH with its system (diagnostics only; costs a file write per solve; the
+//! file is replaced whole, so a run may be stopped at any time).
 //!
 //! Format, little-endian u64 / f64: `n, nnz, n_border, has_groups`, then `col_ptr (n + 1)`,
 //! `row_idx (nnz)`, `values (nnz)`, `rhs (n)`, `border (n_border)`, `groups (n, if any)`.
@@ -33,8 +34,11 @@ pub fn write(path: &Path, a: &SparseMatrix, rhs: &[f64], border: &[usize]) -> Re
         int(v, &mut out);
     }
     let fail = |e: std::io::Error| Error::LinearSolver(format!("{}: {e}", path.display()));
-    std::fs::File::create(path)
+    // Written aside and renamed, so that a run stopped at any moment leaves a whole system.
+    let aside = path.with_extension("partial");
+    std::fs::File::create(&aside)
         .and_then(|mut f| f.write_all(&out))
+        .and_then(|()| std::fs::rename(&aside, path))
         .map_err(fail)
 }
 
