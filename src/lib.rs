@@ -13,6 +13,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bench;
+pub mod cad;
 pub mod contact;
 pub mod element;
 pub mod error;

@@ -12,6 +12,7 @@ pub mod builders;
 pub mod bvh;
 mod check;
 pub mod cylinder;
+pub mod nurbs;
 pub mod patch_surface;
 pub mod patch_table;
 pub mod plane;
@@ -19,6 +20,7 @@ pub mod seams;
 pub mod sphere;
 #[cfg(test)]
 pub(crate) mod testutil;
+pub mod trim;
 
 pub(crate) use check::{finite_vec3, fmt_vec3, positive_length, unit_vec3};
 

@@ -31,6 +31,7 @@
 use super::bezier::{BezierPatch, PatchPoint};
 use super::bvh::{box_distance, Bvh};
 use super::seams::{seam_report, SeamReport};
+use super::trim::PieceTrim;
 use super::*;
 use crate::{Error, Result};
 use nalgebra::{Matrix2, Matrix3x2};
@@ -53,6 +54,9 @@ pub struct PatchSurface {
     scale: f64,
     /// Worst gap and kink where patches meet, measured at construction.
     seams: SeamReport,
+    /// Per patch, the trimmed face it belongs to (if any): a foot outside the trim is not a
+    /// foot of that patch.
+    trims: Vec<Option<PieceTrim>>,
 }
 /// Which bounds of `[0, 1]^2` hold the foot: the strictly active constraints.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,6 +95,25 @@ impl PatchSurface {
     /// Errs if there is no patch, or if two patches meeting at a seam face opposite ways
     /// (see [`seam_report`]). The seam report is kept ([`PatchSurface::seams`]).
     pub fn new(patches: Vec<BezierPatch>) -> Result<PatchSurface> {
+        let untrimmed = vec![None; patches.len()];
+        PatchSurface::with_trims(patches, untrimmed)
+    }
+
+    /// As [`PatchSurface::new`], with patch `k` restricted to the trimmed face `trims[k]`
+    /// (`None`: the whole patch). The projection returns no foot of a patch outside its
+    /// trim; the neighbouring face across the trimming curve answers instead. The seam
+    /// report samples the untrimmed patches' edges.
+    pub fn with_trims(
+        patches: Vec<BezierPatch>,
+        trims: Vec<Option<PieceTrim>>,
+    ) -> Result<PatchSurface> {
+        if trims.len() != patches.len() {
+            return Err(Error::input(
+                "patch surface trim count",
+                trims.len(),
+                &format!("must equal the patch count {}", patches.len()),
+            ));
+        }
         if patches.is_empty() {
             return Err(Error::input("patch surface patch count", 0, "must be >= 1"));
         }
@@ -114,6 +137,7 @@ impl PatchSurface {
             use_bvh: true,
             scale: (hi - lo).norm(),
             seams: SeamReport::default(),
+            trims,
         };
         surface.seams = seam_report(&surface)?;
         Ok(surface)
@@ -146,6 +170,18 @@ impl PatchSurface {
 
     pub fn patches(&self) -> &[BezierPatch] {
         &self.patches
+    }
+
+    /// Per patch, its trimmed face (`None`: the whole patch).
+    pub fn trims(&self) -> &[Option<PieceTrim>] {
+        &self.trims
+    }
+
+    /// True if the foot `loc` of patch `k` lies on the patch's trimmed face.
+    fn on_face(&self, k: usize, loc: &Local) -> bool {
+        self.trims[k]
+            .as_ref()
+            .is_none_or(|t| t.admits(loc.u, loc.v))
     }
 
     /// Worst position gap and normal kink across the seams, from construction.
@@ -410,8 +446,9 @@ impl RigidSurface for PatchSurface {
         let tol = 1e-10 * self.scale;
         let hinted =
             hint.filter(|h| h.patch < self.patches.len() && h.u.is_finite() && h.v.is_finite());
-        let mut best: Option<(usize, Local)> =
-            hinted.map(|h| (h.patch, self.closest_on_patch(h.patch, x, Some((h.u, h.v)))));
+        let mut best: Option<(usize, Local)> = hinted
+            .map(|h| (h.patch, self.closest_on_patch(h.patch, x, Some((h.u, h.v)))))
+            .filter(|(k, loc)| self.on_face(*k, loc));
         let hinted_patch = hinted.map(|h| h.patch);
         // Pruning bound: a candidate replaces the best only if closer by the hysteresis
         // margin, or equally close (within tol) with a better-ranked foot. An interior best
@@ -431,6 +468,7 @@ impl RigidSurface for PatchSurface {
             if Some(k) != hinted_patch {
                 let c = self.closest_on_patch(k, x, None);
                 let replace = match &best {
+                    _ if !self.on_face(k, &c) => false,
                     None => true,
                     Some((kb, b)) => {
                         let margin = if Some(*kb) == hinted_patch { tol } else { 0.0 };

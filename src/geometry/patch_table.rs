@@ -67,7 +67,7 @@ pub fn patch_from_rows(
 }
 
 /// `Error::Input(m)` -> `Error::Input("name: m")`.
-fn prefix(name: &str, e: Error) -> Error {
+pub(crate) fn prefix(name: &str, e: Error) -> Error {
     match e {
         Error::Input(m) => Error::Input(format!("{name}: {m}")),
         other => other,
@@ -77,7 +77,7 @@ fn prefix(name: &str, e: Error) -> Error {
 /// What a wrong JSON value is, for an error message: its kind, and the value itself only
 /// for numbers and booleans. A table may come from a file, and error messages never echo a
 /// file's text (issue 16).
-fn kind(v: &Value) -> String {
+pub(crate) fn kind(v: &Value) -> String {
     match v {
         Value::Null => "null".into(),
         Value::Bool(b) => b.to_string(),
@@ -88,17 +88,17 @@ fn kind(v: &Value) -> String {
     }
 }
 
-fn number(v: &Value, what: &str) -> Result<f64> {
+pub(crate) fn number(v: &Value, what: &str) -> Result<f64> {
     v.as_f64()
         .ok_or_else(|| Error::input(what, kind(v), "must be a number"))
 }
 
-fn array<'a>(v: &'a Value, what: &str) -> Result<&'a Vec<Value>> {
+pub(crate) fn array<'a>(v: &'a Value, what: &str) -> Result<&'a Vec<Value>> {
     v.as_array()
         .ok_or_else(|| Error::input(what, kind(v), "must be an array"))
 }
 
-fn point(v: &Value, what: &str) -> Result<Vec3> {
+pub(crate) fn point(v: &Value, what: &str) -> Result<Vec3> {
     let a = array(v, what)?;
     if a.len() != 3 {
         return Err(Error::input(what, kind(v), "must be [x, y, z]"));

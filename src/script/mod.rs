@@ -4,6 +4,7 @@
 //! below this module knows that Rhai exists. Scripts run sandboxed: operation, call-depth
 //! and size limits, and output only below the run's output folder.
 
+mod api_cad;
 mod api_charts;
 mod api_mesh_map;
 mod api_scene;
@@ -106,6 +107,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.on_progress(move |ops| limits::progress_check(&limits, &clock, ops).map(Dynamic::from));
     let host = Rc::new(host);
     api_scene::register(&mut engine, host.clone());
+    api_cad::register(&mut engine, policy.clone());
     api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);
