@@ -118,7 +118,7 @@ fn uniaxial_tension_to_50_percent_follows_the_swift_curve() {
 
     // Output: the thickness (z) of the sheet columns and its log strain, and the
     // equivalent plastic strain, as VTK fields.
-    let frame = tribo::output::run::frame(&sim);
+    let frame = tribo::output::frame(&sim, tribo::output::Configuration::Current);
     let field = |name: &str, cells: bool| {
         let list = if cells {
             &frame.cell_data

@@ -28,6 +28,10 @@ pub struct ContactNodeState {
     pub flips: usize,
     /// Friction coefficient to use in the next increment.
     pub mu: f64,
+    /// Tangential slip delta_t of the last converged increment (zero out of contact); for
+    /// output only.
+    #[serde(default)]
+    pub slip_increment: Vec3,
 }
 
 impl ContactNodeState {

@@ -1,7 +1,7 @@
 //! A frame's nodal field on a face set, ready for a top-view colour map
 //! ([`super::svg::FieldMap`]).
 //!
-//! Field names are those of the VTK frames ([`super::run::frame`]): a scalar point field
+//! Field names are those of the VTK frames ([`super::blank_frame::frame`]): a scalar point field
 //! (`frictional_work`, `mu`, `contact_status`, ...), one component of a vector point field
 //! (`displacement_z`), or a scalar cell field (`von_mises`, ...), which is averaged onto the
 //! nodes over the elements around each node (unweighted: the mean of the adjacent cells).
@@ -11,26 +11,7 @@ use super::{Field, Frame};
 use crate::solver::Simulation;
 use crate::{Error, Result};
 
-/// Where the faces are drawn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Configuration {
-    Reference,
-    Current,
-}
-
-impl Configuration {
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "reference" => Ok(Configuration::Reference),
-            "current" => Ok(Configuration::Current),
-            other => Err(Error::input(
-                "configuration",
-                format!("\"{other}\""),
-                "must be \"reference\" or \"current\"",
-            )),
-        }
-    }
-}
+pub use super::blank_frame::Configuration;
 
 /// One value per node of the field `name` of `frame`.
 pub fn nodal_values(frame: &Frame, name: &str) -> Result<Vec<f64>> {
@@ -109,7 +90,7 @@ pub fn field_map(
             "node set '{face_set}' holds no boundary face to draw"
         )));
     }
-    let frame = super::run::frame(sim);
+    let frame = super::blank_frame::frame(sim, Configuration::Reference);
     let values = nodal_values(&frame, field)?;
     let u = sim.displacements();
     let points = mesh

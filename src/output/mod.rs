@@ -10,12 +10,15 @@
 //! Numbers in text formats (`.csv`, `.pvd` timesteps) use Rust's shortest representation that
 //! round-trips exactly (`{}` or `{:e}`), so parsing them back gives the same `f64`.
 
+mod blank_frame;
+mod cadence;
 mod csv;
 pub mod field_chart;
 mod folder;
 mod pvd;
 mod summary;
 pub mod svg;
+mod tool_frame;
 mod vtk;
 
 pub mod run;
@@ -23,9 +26,14 @@ pub mod run;
 pub use self::csv::HistoryCsv;
 pub use self::folder::{FolderLock, OutputFolder, LOCK_FILE};
 pub use self::pvd::{PvdEntry, PvdSeries};
-pub use self::run::RunOutput;
+pub use self::run::{FrameOptions, RunOutput};
 pub use self::summary::{write_summary, SUMMARY_FILE};
-pub use self::vtk::{read_vtu, read_vtu_point_field, write_vtu, Field, Frame};
+pub use self::blank_frame::{frame, Configuration};
+pub use self::cadence::{Cadence, DEFAULT_FRAMES};
+pub use self::tool_frame::tool_frame;
+pub use self::vtk::{
+    read_vtu, read_vtu_point_field, write_vtu, Field, Frame, SYMMETRIC_TENSOR_COMPONENTS,
+};
 
 use crate::{Error, Result};
 use std::io::Write;

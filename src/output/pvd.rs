@@ -1,8 +1,13 @@
-//! ParaView time-series collection (`.pvd`): one `<DataSet timestep=".." file=".."/>` per frame.
+//! ParaView time-series collection (`.pvd`): one `<DataSet timestep=".." part=".." file=".."/>`
+//! per frame and part.
+//!
+//! Parts are the blocks shown together at one time: part 0 is the blank, parts 1.. the tools'
+//! display surfaces. ParaView's PVD reader makes one block per part, so opening the `.pvd`
+//! shows blank and tools moving together; `name` labels the block.
 //!
 //! The whole `.pvd` is rewritten atomically (temp file + rename) on creation and after each
-//! [`PvdSeries::add`], so it is a complete, valid XML file listing every frame added so far even if
-//! the run stops mid-way.
+//! change ([`PvdSeries::add`], [`PvdSeries::add_parts`], [`PvdSeries::truncate`]), so it is a
+//! complete, valid XML file listing every frame kept so far even if the run stops mid-way.
 
 use crate::{Error, Result};
 use std::path::{Component, Path, PathBuf};
@@ -12,6 +17,10 @@ use std::path::{Component, Path, PathBuf};
 pub struct PvdEntry {
     /// Simulation time of the frame.
     pub time: f64,
+    /// Block of the frame (0: the blank).
+    pub part: usize,
+    /// Name of the block ("" for none).
+    pub name: String,
     /// Path of the `.vtu`, relative to the folder of the `.pvd`, with `/` separators.
     pub file: String,
 }
@@ -48,23 +57,49 @@ impl PvdSeries {
     }
 
     /// Adds the frame at `time` stored in `relative_vtu_file` (relative to the `.pvd`'s folder;
-    /// absolute paths, `..` components and non-finite times are refused) and rewrites the `.pvd`.
+    /// absolute paths, `..` components and non-finite times are refused) as part 0 and
+    /// rewrites the `.pvd`.
     pub fn add(&mut self, time: f64, relative_vtu_file: impl AsRef<Path>) -> Result<()> {
-        let rel = relative_vtu_file.as_ref();
-        if !time.is_finite() {
-            return Err(Error::input(
-                &format!("time of pvd dataset {}", rel.display()),
+        self.add_parts(time, &[("", relative_vtu_file.as_ref())])
+    }
+
+    /// Adds the blocks of one frame at `time`: `parts[i]` = (name, file) becomes part `i`.
+    /// Nothing is added if any file is refused or the `.pvd` cannot be written.
+    pub fn add_parts(&mut self, time: f64, parts: &[(&str, &Path)]) -> Result<()> {
+        let mut entries = Vec::with_capacity(parts.len());
+        for (part, (name, rel)) in parts.iter().enumerate() {
+            if !time.is_finite() {
+                return Err(Error::input(
+                    &format!("time of pvd dataset {}", rel.display()),
+                    time,
+                    "must be finite",
+                ));
+            }
+            entries.push(PvdEntry {
                 time,
-                "must be finite",
-            ));
+                part,
+                name: name.to_string(),
+                file: relative_file_string(rel)?,
+            });
         }
-        let file = relative_file_string(rel)?;
-        self.entries.push(PvdEntry { time, file });
+        let kept = self.entries.len();
+        self.entries.extend(entries);
         if let Err(e) = self.write() {
-            self.entries.pop();
+            self.entries.truncate(kept);
             return Err(e);
         }
         Ok(())
+    }
+
+    /// Keeps the first `frames` frames (a frame starts at each part-0 entry) and rewrites
+    /// the `.pvd`.
+    pub fn truncate(&mut self, frames: usize) -> Result<()> {
+        let keep = (self.entries.iter().enumerate())
+            .filter(|(_, e)| e.part == 0)
+            .nth(frames)
+            .map_or(self.entries.len(), |(i, _)| i);
+        self.entries.truncate(keep);
+        self.write()
     }
 
     /// Path of the `.pvd` file.
@@ -86,8 +121,14 @@ impl PvdSeries {
         );
         for e in &self.entries {
             s.push_str(&format!(
-                "    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}\"/>\n",
+                "    <DataSet timestep=\"{}\" group=\"\" part=\"{}\"{} file=\"{}\"/>\n",
                 super::fmt_f64(e.time),
+                e.part,
+                if e.name.is_empty() {
+                    String::new()
+                } else {
+                    format!(" name=\"{}\"", super::xml_escape(&e.name))
+                },
                 super::xml_escape(&e.file)
             ));
         }

@@ -1,10 +1,12 @@
-//! Everything a run writes to its output folder: a VTK frame per output increment with a
-//! .pvd series, history.csv (one row per converged increment) and summary.json.
-//! Files are flushed as they are written, so a run that stops keeps everything so far.
+//! Everything a run writes to its output folder: VTK frames of the blank and the tools at the
+//! output cadence with a .pvd series, history.csv (one row per converged increment) and
+//! summary.json. Files are flushed as they are written, so a run that stops keeps
+//! everything so far.
 
-use super::{write_summary, write_vtu, Field, Frame, HistoryCsv, OutputFolder, PvdSeries};
-use crate::contact::ContactStatus;
-use crate::geometry::Vec3;
+use super::{
+    blank_frame, tool_frame, write_summary, write_vtu, Cadence, Configuration, HistoryCsv,
+    OutputFolder, PvdSeries,
+};
 use crate::solver::{IncrementReport, Simulation};
 use crate::Result;
 use std::path::Path;
@@ -21,8 +23,28 @@ pub struct Stop {
     pub write_failures: Vec<String>,
 }
 
+/// What the frames hold and when they are written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameOptions {
+    /// Where the blank's points are: current (default) or reference configuration.
+    pub points: Configuration,
+    /// When frames are written.
+    pub cadence: Cadence,
+}
+
+impl FrameOptions {
+    /// The defaults for a run to `end_time`: current configuration, an interval cadence.
+    pub fn default_for(end_time: f64) -> Self {
+        FrameOptions {
+            points: Configuration::Current,
+            cadence: Cadence::default_for(end_time),
+        }
+    }
+}
+
 pub struct RunOutput {
     folder: OutputFolder,
+    frames: FrameOptions,
     pvd: PvdSeries,
     history: HistoryCsv,
     /// Entries a script added to summary.json (top level, beside the built-in ones).
@@ -32,7 +54,7 @@ pub struct RunOutput {
 }
 
 impl RunOutput {
-    pub fn create(dir: &Path, sim: &Simulation) -> Result<Self> {
+    pub fn create(dir: &Path, sim: &Simulation, frames: FrameOptions) -> Result<Self> {
         let folder = OutputFolder::create(dir)?;
         for (path, pid) in remove_stale_temporaries(folder.root()) {
             eprintln!(
@@ -93,6 +115,7 @@ impl RunOutput {
         let history = HistoryCsv::create(folder.resolve_for_write("history.csv")?, &columns)?;
         Ok(RunOutput {
             folder,
+            frames,
             pvd,
             history,
             extra: serde_json::Map::new(),
@@ -103,12 +126,21 @@ impl RunOutput {
     /// Continues the output of a restarted run in `dir`: history.csv is written again from
     /// the restored increment reports, and the frames the run had written before the
     /// checkpoint (`frame_times`) are listed in the .pvd when their files are there.
-    pub fn resume(dir: &Path, sim: &Simulation, frame_times: &[f64]) -> Result<Self> {
-        let mut out = RunOutput::create(dir, sim)?;
+    pub fn resume(
+        dir: &Path,
+        sim: &Simulation,
+        frames: FrameOptions,
+        frame_times: &[f64],
+    ) -> Result<Self> {
+        let mut out = RunOutput::create(dir, sim, frames)?;
         for (i, &t) in frame_times.iter().enumerate() {
-            let name = format!("frames/frame_{i:04}.vtu");
-            if out.folder.resolve(&name)?.is_file() {
-                out.pvd.add(t, &name)?;
+            let names = out.frame_files(sim, i);
+            if out.folder.resolve(&names[0].1)?.is_file() {
+                let parts: Vec<(&str, &Path)> = (names.iter())
+                    .filter(|(_, f)| out.folder.resolve(f).is_ok_and(|p| p.is_file()))
+                    .map(|(n, f)| (n.as_str(), Path::new(f.as_str())))
+                    .collect();
+                out.pvd.add_parts(t, &parts)?;
             }
         }
         out.frame_times = frame_times.to_vec();
@@ -200,14 +232,93 @@ impl RunOutput {
         self.history.append(&row)
     }
 
-    /// Writes the committed state as frames/frame_NNNN.vtu and adds it to frames.pvd.
+    /// (block name, file) of each part of frame `index`: the blank, then every tool with a
+    /// display surface (patch surfaces), as frames/frame_NNNN.vtu and
+    /// frames/frame_NNNN_<tool>.vtu.
+    fn frame_files(&self, sim: &Simulation, index: usize) -> Vec<(String, String)> {
+        let mut files = vec![("blank".to_string(), format!("frames/frame_{index:04}.vtu"))];
+        for c in &sim.model.contacts {
+            if c.tool.surface.as_patch_surface().is_some() {
+                files.push((
+                    c.tool.name.clone(),
+                    format!("frames/frame_{index:04}_{}.vtu", file_safe(&c.tool.name)),
+                ));
+            }
+        }
+        files
+    }
+
+    /// The frame options of this run.
+    pub fn frame_options(&self) -> FrameOptions {
+        self.frames
+    }
+
+    /// Writes the committed state as frames/frame_NNNN.vtu (the blank) and
+    /// frames/frame_NNNN_<tool>.vtu (each tool's display surface at its pose), and adds them
+    /// to frames.pvd as the parts of one time.
     pub fn write_frame(&mut self, sim: &Simulation) -> Result<()> {
-        let name = format!("frames/frame_{:04}.vtu", self.frame_times.len());
-        let path = self.folder.resolve_for_write(&name)?;
-        write_vtu(&path, &frame(sim))?;
-        self.pvd.add(sim.time(), &name)?;
+        let index = self.frame_times.len();
+        let files = self.frame_files(sim, index);
+        write_vtu(
+            &self.folder.resolve_for_write(&files[0].1)?,
+            &blank_frame::frame(sim, self.frames.points),
+        )?;
+        let mut tool_files = files[1..].iter();
+        for (c, contact) in sim.model.contacts.iter().enumerate() {
+            if let Some(tool) = tool_frame::tool_frame(&contact.tool, &sim.tool_pose(c)) {
+                let (_, file) = tool_files.next().expect("one file per patch tool");
+                write_vtu(&self.folder.resolve_for_write(file)?, &tool)?;
+            }
+        }
+        let parts: Vec<(&str, &Path)> = (files.iter())
+            .map(|(n, f)| (n.as_str(), Path::new(f.as_str())))
+            .collect();
+        self.pvd.add_parts(sim.time(), &parts)?;
         self.frame_times.push(sim.time());
         Ok(())
+    }
+
+    /// Writes a frame if the cadence asks for one after increment `index` (or the run has
+    /// finished, or no frame exists yet).
+    pub fn write_frame_if_due(&mut self, sim: &Simulation, index: usize) -> Result<()> {
+        let last = self.frame_times.last().copied();
+        if self
+            .frames
+            .cadence
+            .due(index, sim.time(), last, sim.is_finished())
+        {
+            self.write_frame(sim)?;
+        }
+        Ok(())
+    }
+
+    /// A frame of the committed state unless the last frame is already at its time (a run
+    /// that stops keeps its last converged state in ParaView).
+    pub fn write_last_frame(&mut self, sim: &Simulation) -> Result<()> {
+        if self.frame_times.last() != Some(&sim.time()) {
+            self.write_frame(sim)?;
+        }
+        Ok(())
+    }
+
+    /// After a rollback to `sim`'s time: forgets the frames written after it (their files
+    /// are removed) and rewrites frames.pvd and history.csv to the kept history.
+    pub fn rollback(&mut self, sim: &Simulation) -> Result<()> {
+        let kept = self
+            .frame_times
+            .iter()
+            .take_while(|&&t| t <= sim.time())
+            .count();
+        for index in kept..self.frame_times.len() {
+            for (_, file) in self.frame_files(sim, index) {
+                if let Ok(path) = self.folder.resolve(&file) {
+                    let _ = std::fs::remove_file(path);
+                }
+            }
+        }
+        self.frame_times.truncate(kept);
+        self.pvd.truncate(kept)?;
+        self.record(sim)
     }
 
     /// Adds (or replaces) a top-level entry of summary.json, written with the next
@@ -315,6 +426,8 @@ impl RunOutput {
             "energy": sim.energy(),
             "tools": tools,
             "frames": self.frame_times.len(),
+            "frame_cadence": self.frames.cadence.describe(),
+            "frame_points": self.frames.points.name(),
             "rejected_steps": sim.history.iter().map(|r| r.rejected).sum::<usize>(),
             "line_search_cuts": sim.history.iter().map(|r| r.line_search_cuts).sum::<usize>(),
             "increments_with_cycling": sim.history.iter().filter(|r| !r.cycling.is_empty()).count(),
@@ -332,6 +445,20 @@ impl RunOutput {
         }
         write_summary(&self.folder.resolve_for_write("summary.json")?, &summary)
     }
+}
+
+/// A tool name as part of a file name: ASCII letters, digits, `-` and `_` kept, anything
+/// else `_`.
+fn file_safe(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 /// Removes the temporary files of atomic writes (`.NAME.PID.tmp`, see `write_atomic`) that
@@ -382,114 +509,6 @@ fn stale_temporary_pid(name: &str) -> Option<u32> {
         return None;
     }
     pid.parse().ok()
-}
-
-/// The committed state as a VTK frame: displacement and contact fields on the nodes (and,
-/// for sheet meshes with through-thickness columns, the current thickness and the
-/// thickness strain ln(t/t0) of each column on its nodes), element-averaged Cauchy stress,
-/// von Mises stress and equivalent plastic strain on the cells. A node touching several tools shows the tool
-/// pressing it hardest.
-pub fn frame(sim: &Simulation) -> Frame {
-    let mesh = &sim.model.mesh;
-    let n = mesh.nodes.len();
-    let u = sim.displacements();
-    let mut status = vec![0.0; n];
-    let mut gap = vec![f64::NAN; n];
-    let mut lambda_n = vec![0.0; n];
-    let mut lambda_t = vec![0.0; n];
-    let mut pressure = vec![0.0; n];
-    let mut work = vec![0.0; n];
-    let mut slip = vec![0.0; n];
-    let mut mu = vec![0.0; n];
-    let mut theta = vec![0.0; n];
-    let mut flips = vec![0.0; n];
-    for (c, contact) in sim.model.contacts.iter().enumerate() {
-        for (k, s) in sim.contact_states(c).iter().enumerate() {
-            let node = contact.candidates[k];
-            let ln = s.lambda_n();
-            let first = gap[node].is_nan();
-            if first || ln < lambda_n[node] || (ln == lambda_n[node] && s.gap < gap[node]) {
-                status[node] = s.status.code();
-                gap[node] = s.gap;
-                lambda_n[node] = ln;
-                lambda_t[node] = s.lambda_t_norm();
-                pressure[node] = if s.status == ContactStatus::Gap {
-                    0.0
-                } else {
-                    -ln / contact.areas[k].max(f64::MIN_POSITIVE)
-                };
-                mu[node] = s.mu;
-                theta[node] = s.theta;
-            }
-            flips[node] += s.flips as f64;
-            work[node] += s.work;
-            slip[node] = f64::max(slip[node], s.slip);
-        }
-    }
-    for g in gap.iter_mut().filter(|g| g.is_nan()) {
-        *g = 0.0;
-    }
-    let per = sim.points().len() / mesh.hexes.len().max(1);
-    let mut stress = vec![0.0; 6 * mesh.hexes.len()];
-    let mut von_mises = vec![0.0; mesh.hexes.len()];
-    let mut eq_plastic = vec![0.0; mesh.hexes.len()];
-    for e in 0..mesh.hexes.len() {
-        let pts = &sim.points()[e * per..(e + 1) * per];
-        for p in pts {
-            for i in 0..6 {
-                stress[6 * e + i] += p.stress[i] / per as f64;
-            }
-            eq_plastic[e] += p.eq_plastic_strain / per as f64;
-        }
-        let s = &stress[6 * e..6 * e + 6];
-        von_mises[e] = (0.5
-            * ((s[0] - s[1]).powi(2) + (s[1] - s[2]).powi(2) + (s[2] - s[0]).powi(2))
-            + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]))
-            .sqrt();
-    }
-    // Sheet thickness per through-thickness column (block meshes), on the column's nodes.
-    let mut sheet_fields = Vec::new();
-    if !mesh.columns().is_empty() {
-        let disp = |n: usize| Vec3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2]);
-        let current = mesh.column_thicknesses(disp);
-        let initial = mesh.column_thicknesses(|_| Vec3::zeros());
-        let mut thickness = vec![0.0; n];
-        let mut thickness_strain = vec![0.0; n];
-        for (k, col) in mesh.columns().iter().enumerate() {
-            for &node in col {
-                thickness[node] = current[k];
-                thickness_strain[node] = (current[k] / initial[k]).ln();
-            }
-        }
-        sheet_fields.push(Field::scalar("thickness", thickness));
-        sheet_fields.push(Field::scalar("thickness_strain", thickness_strain));
-    }
-    // VTK orders symmetric tensors xx, yy, zz, xy, yz, xz, as our Voigt vector.
-    Frame {
-        points: mesh.nodes.iter().map(|p| [p.x, p.y, p.z]).collect(),
-        hexes: mesh.hexes.clone(),
-        point_data: vec![
-            Field::new("displacement", 3, u.to_vec()),
-            Field::scalar("contact_status", status),
-            Field::scalar("gap", gap),
-            Field::scalar("lambda_n", lambda_n),
-            Field::scalar("lambda_t_norm", lambda_t),
-            Field::scalar("contact_pressure", pressure),
-            Field::scalar("frictional_work", work),
-            Field::scalar("accumulated_slip", slip),
-            Field::scalar("mu", mu),
-            Field::scalar("theta", theta),
-            Field::scalar("stick_slip_flips", flips),
-        ]
-        .into_iter()
-        .chain(sheet_fields)
-        .collect(),
-        cell_data: vec![
-            Field::new("stress", 6, stress),
-            Field::scalar("von_mises", von_mises),
-            Field::scalar("equivalent_plastic_strain", eq_plastic),
-        ],
-    }
 }
 
 #[cfg(test)]

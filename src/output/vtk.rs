@@ -1,10 +1,15 @@
-//! VTK XML unstructured grid (`.vtu`) frames of a hexahedral mesh.
+//! VTK XML unstructured grid (`.vtu`) frames of a hexahedral mesh (the blank) or of
+//! quadrilaterals (a tool's display surface).
 //!
 //! [`Frame`] is a format-neutral description of one output frame; [`write_vtu`] writes it as an
 //! XML `.vtu` file (VTK file version 1.0, little-endian, `header_type="UInt64"`, inline base64
 //! binary arrays, *uncompressed*), which ParaView and VTK read. Float data is written as
 //! `Float64`, so values read back bit-exactly. [`read_vtu`] / [`read_vtu_point_field`] read such a
 //! file back (through vtkio's reader) for tests and tools.
+//!
+//! Component names (`ComponentName0="xx"` ... on a `<DataArray>`, which ParaView shows as
+//! `stress_xx` and so on) are not part of vtkio's model: they are added to the tags of the
+//! encoded XML and read back from them with quick-xml.
 
 use crate::{Error, Result};
 use std::path::Path;
@@ -13,7 +18,7 @@ use vtkio::model::{
     Piece, UnstructuredGridPiece, Version, VertexNumbers, Vtk,
 };
 
-/// One output frame: a hexahedral mesh with point and cell fields.
+/// One output frame: hexahedra and/or quadrilaterals with point and cell fields.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Frame {
     /// Point coordinates.
@@ -21,9 +26,11 @@ pub struct Frame {
     /// 8-node hexahedra, node order as VTK_HEXAHEDRON (bottom face 0-1-2-3 counter-clockwise seen
     /// from the top, then top face 4-5-6-7 above 0-1-2-3), indices into `points`.
     pub hexes: Vec<[usize; 8]>,
+    /// 4-node quadrilaterals (VTK_QUAD), after the hexahedra in the file's cell order.
+    pub quads: Vec<[usize; 4]>,
     /// Fields with one tuple per point.
     pub point_data: Vec<Field>,
-    /// Fields with one tuple per hexahedron.
+    /// Fields with one tuple per cell (hexahedra first, then quadrilaterals).
     pub cell_data: Vec<Field>,
 }
 
@@ -34,7 +41,13 @@ pub struct Field {
     pub name: String,
     pub components: usize,
     pub values: Vec<f64>,
+    /// Names of the components (`xx`, `yy`, ...), written as VTK `ComponentName`s; empty for
+    /// none (ParaView then numbers them, or says X, Y, Z for 3 components).
+    pub component_names: Vec<String>,
 }
+
+/// Component names of a symmetric tensor in VTK's (and tribo's Voigt) order.
+pub const SYMMETRIC_TENSOR_COMPONENTS: [&str; 6] = ["xx", "yy", "zz", "xy", "yz", "xz"];
 
 impl Field {
     /// A field with `components` values per tuple.
@@ -43,7 +56,20 @@ impl Field {
             name: name.into(),
             components,
             values,
+            component_names: Vec::new(),
         }
+    }
+
+    /// A symmetric tensor field, 6 values per tuple in the order of
+    /// [`SYMMETRIC_TENSOR_COMPONENTS`], with those component names.
+    pub fn symmetric_tensor(name: impl Into<String>, values: Vec<f64>) -> Self {
+        Field::new(name, 6, values).named_components(&SYMMETRIC_TENSOR_COMPONENTS)
+    }
+
+    /// The field with the given component names.
+    pub fn named_components(mut self, names: &[&str]) -> Self {
+        self.component_names = names.iter().map(|s| s.to_string()).collect();
+        self
     }
 
     /// A scalar field (one value per tuple).
@@ -63,21 +89,35 @@ impl Field {
 }
 
 impl Frame {
-    /// Checks that every hex references existing points and that every field has a non-empty
-    /// unique name, at least one component and exactly `components * count` values.
+    /// Number of cells (hexahedra and quadrilaterals).
+    pub fn cell_count(&self) -> usize {
+        self.hexes.len() + self.quads.len()
+    }
+
+    /// Checks that every cell references existing points and that every field has a non-empty
+    /// unique name, at least one component, exactly `components * count` values, and either
+    /// no component names or one per component.
     pub fn validate(&self) -> Result<()> {
         let np = self.points.len();
-        for (h, hex) in self.hexes.iter().enumerate() {
-            if let Some(&bad) = hex.iter().find(|&&n| n >= np) {
+        let cells = (self.hexes.iter().map(|h| ("hexahedron", &h[..])))
+            .enumerate()
+            .chain(
+                self.quads
+                    .iter()
+                    .enumerate()
+                    .map(|(i, q)| (i, ("quadrilateral", &q[..]))),
+            );
+        for (i, (kind, nodes)) in cells {
+            if let Some(&bad) = nodes.iter().find(|&&n| n >= np) {
                 return Err(Error::input(
-                    &format!("node index of hexahedron {h}"),
+                    &format!("node index of {kind} {i}"),
                     bad,
                     &format!("must be < number of points ({np})"),
                 ));
             }
         }
         check_fields(&self.point_data, "point", np)?;
-        check_fields(&self.cell_data, "cell", self.hexes.len())
+        check_fields(&self.cell_data, "cell", self.cell_count())
     }
 }
 
@@ -102,6 +142,14 @@ fn check_fields(fields: &[Field], kind: &str, count: usize) -> Result<()> {
                 &format!("components of {kind} field \"{}\"", f.name),
                 0,
                 "must be >= 1",
+            ));
+        }
+        let names = f.component_names.len();
+        if names != 0 && names != f.components {
+            return Err(Error::input(
+                &format!("component names of {kind} field \"{}\"", f.name),
+                names,
+                &format!("must be 0 or the number of components ({})", f.components),
             ));
         }
         let expected = f.components.checked_mul(count);
@@ -148,8 +196,16 @@ pub fn write_vtu(path: &Path, frame: &Frame) -> Result<()> {
         }
     }
     let points: Vec<f64> = frame.points.iter().flatten().copied().collect();
-    let connectivity: Vec<u64> = frame.hexes.iter().flatten().map(|&n| n as u64).collect();
-    let offsets: Vec<u64> = (1..=frame.hexes.len() as u64).map(|i| 8 * i).collect();
+    let connectivity: Vec<u64> = (frame.hexes.iter().flatten())
+        .chain(frame.quads.iter().flatten())
+        .map(|&n| n as u64)
+        .collect();
+    let offsets: Vec<u64> = (1..=frame.hexes.len() as u64)
+        .map(|i| 8 * i)
+        .chain((1..=frame.quads.len() as u64).map(|i| 8 * frame.hexes.len() as u64 + 4 * i))
+        .collect();
+    let mut types = vec![CellType::Hexahedron; frame.hexes.len()];
+    types.resize(frame.cell_count(), CellType::Quad);
     let vtk = Vtk {
         version: Version::new_xml(1, 0),
         title: String::new(),
@@ -162,7 +218,7 @@ pub fn write_vtu(path: &Path, frame: &Frame) -> Result<()> {
                     connectivity,
                     offsets,
                 },
-                types: vec![CellType::Hexahedron; frame.hexes.len()],
+                types,
             },
             data: Attributes {
                 point: to_attributes(&frame.point_data),
@@ -174,7 +230,78 @@ pub fn write_vtu(path: &Path, frame: &Frame) -> Result<()> {
     let mut bytes = Vec::new();
     vtk.write_xml(&mut bytes)
         .map_err(|e| Error::io(path, format!("VTK XML encoding failed: {e}")))?;
-    super::write_atomic(path, &bytes)
+    let text = String::from_utf8(bytes)
+        .map_err(|_| Error::io(path, "VTK XML encoding is not UTF-8"))?;
+    let text = with_component_names(text, "PointData", &frame.point_data);
+    let text = with_component_names(text, "CellData", &frame.cell_data);
+    super::write_atomic(path, text.as_bytes())
+}
+
+/// Adds `ComponentName{i}="..."` to the `<DataArray Name="...">` tag of every field of
+/// `fields` with component names, inside the `<section>` element (PointData or CellData) of
+/// the encoded file. The arrays' data is base64 text, so no binary is touched.
+fn with_component_names(mut text: String, section: &str, fields: &[Field]) -> String {
+    let Some(start) = text.find(&format!("<{section}")) else {
+        return text;
+    };
+    for f in fields.iter().filter(|f| !f.component_names.is_empty()) {
+        let end = text[start..]
+            .find(&format!("</{section}>"))
+            .map_or(text.len(), |e| start + e);
+        let key = format!("Name=\"{}\"", super::xml_escape(&f.name));
+        let Some(at) = text[start..end].find(&key) else {
+            continue;
+        };
+        let attrs: String = f
+            .component_names
+            .iter()
+            .enumerate()
+            .map(|(i, c)| format!(" ComponentName{i}=\"{}\"", super::xml_escape(c)))
+            .collect();
+        text.insert_str(start + at + key.len(), &attrs);
+    }
+    text
+}
+
+/// The component names of every `<DataArray>` in the `<section>` element (PointData or
+/// CellData) of a VTK XML file's text, by array name.
+fn read_component_names(
+    text: &str,
+    section: &str,
+) -> std::result::Result<std::collections::HashMap<String, Vec<String>>, String> {
+    use quick_xml::events::Event;
+    let mut reader = quick_xml::Reader::from_str(text);
+    let mut inside = false;
+    let mut names = std::collections::HashMap::new();
+    loop {
+        match reader.read_event().map_err(|e| e.to_string())? {
+            Event::Start(e) | Event::Empty(e) if e.name().as_ref() == section.as_bytes() => {
+                inside = true
+            }
+            Event::End(e) if e.name().as_ref() == section.as_bytes() => inside = false,
+            Event::Start(e) | Event::Empty(e) if inside && e.name().as_ref() == b"DataArray" => {
+                let mut name = String::new();
+                let mut components: Vec<(usize, String)> = Vec::new();
+                for a in e.attributes() {
+                    let a = a.map_err(|e| e.to_string())?;
+                    let value = a.unescape_value().map_err(|e| e.to_string())?.to_string();
+                    let key = String::from_utf8_lossy(a.key.as_ref()).to_string();
+                    if key == "Name" {
+                        name = value;
+                    } else if let Some(i) = key.strip_prefix("ComponentName") {
+                        let i = i.parse().map_err(|_| format!("bad attribute {key}"))?;
+                        components.push((i, value));
+                    }
+                }
+                components.sort();
+                if !components.is_empty() {
+                    names.insert(name, components.into_iter().map(|(_, c)| c).collect());
+                }
+            }
+            Event::Eof => return Ok(names),
+            _ => {}
+        }
+    }
 }
 
 /// Reads a `.vtu` file of hexahedra (as written by [`write_vtu`]) back into a [`Frame`].
@@ -211,17 +338,20 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
     }
     let points: Vec<[f64; 3]> = coords.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
 
-    let ncells = piece.cells.types.len();
-    if let Some(t) = piece
-        .cells
-        .types
+    let types = piece.cells.types.clone();
+    if let Some(t) = types
         .iter()
-        .find(|&&t| t != CellType::Hexahedron)
+        .find(|&&t| t != CellType::Hexahedron && t != CellType::Quad)
     {
         return Err(bad(format!(
-            "cell type {t:?} found, only hexahedra are supported"
+            "cell type {t:?} found, only hexahedra and quadrilaterals are supported"
         )));
     }
+    let nhex = types.iter().take_while(|&&t| t == CellType::Hexahedron).count();
+    if types[nhex..].iter().any(|&t| t != CellType::Quad) {
+        return Err(bad("hexahedra after quadrilaterals".into()));
+    }
+    let nquad = types.len() - nhex;
     let (connectivity, offsets) = match piece.cells.cell_verts {
         VertexNumbers::XML {
             connectivity,
@@ -234,23 +364,47 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
         Some(0) => &offsets[1..],
         _ => &offsets,
     };
-    let expected_offsets: Vec<u64> = (1..=ncells as u64).map(|i| 8 * i).collect();
-    if offsets != expected_offsets.as_slice() || connectivity.len() != 8 * ncells {
-        return Err(bad("cell offsets are not those of 8-node cells".into()));
+    let hex_end = 8 * nhex as u64;
+    let expected_offsets: Vec<u64> = (1..=nhex as u64)
+        .map(|i| 8 * i)
+        .chain((1..=nquad as u64).map(|i| hex_end + 4 * i))
+        .collect();
+    if offsets != expected_offsets.as_slice() || connectivity.len() != 8 * nhex + 4 * nquad {
+        return Err(bad(
+            "cell offsets are not those of 8-node and 4-node cells".into(),
+        ));
     }
-    let mut hexes = Vec::with_capacity(ncells);
-    for c in connectivity.chunks_exact(8) {
-        let mut hex = [0usize; 8];
-        for (h, &n) in hex.iter_mut().zip(c) {
-            *h = usize::try_from(n)
-                .ok()
-                .filter(|&n| n < points.len())
-                .ok_or_else(|| bad(format!("node index {n} out of range")))?;
-        }
-        hexes.push(hex);
-    }
+    let index = |n: u64| {
+        usize::try_from(n)
+            .ok()
+            .filter(|&n| n < points.len())
+            .ok_or_else(|| bad(format!("node index {n} out of range")))
+    };
+    let (hex_nodes, quad_nodes) = connectivity.split_at(8 * nhex);
+    let hexes = hex_nodes
+        .chunks_exact(8)
+        .map(|c| {
+            let mut hex = [0usize; 8];
+            for (h, &n) in hex.iter_mut().zip(c) {
+                *h = index(n)?;
+            }
+            Ok(hex)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let quads = quad_nodes
+        .chunks_exact(4)
+        .map(|c| Ok([index(c[0])?, index(c[1])?, index(c[2])?, index(c[3])?]))
+        .collect::<Result<Vec<_>>>()?;
+    let text = std::str::from_utf8(&bytes).map_err(|_| bad("file is not UTF-8".into()))?;
+    let point_names =
+        read_component_names(text, "PointData").map_err(|e| bad(format!("bad XML: {e}")))?;
+    let cell_names =
+        read_component_names(text, "CellData").map_err(|e| bad(format!("bad XML: {e}")))?;
 
-    let fields = |attrs: Vec<Attribute>, kind: &str| -> Result<Vec<Field>> {
+    let fields = |attrs: Vec<Attribute>,
+                  kind: &str,
+                  names: &std::collections::HashMap<String, Vec<String>>|
+     -> Result<Vec<Field>> {
         attrs
             .into_iter()
             .filter_map(|a| match a {
@@ -264,6 +418,7 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
                     .ok_or_else(|| bad(format!("{kind} field \"{}\" is not numeric", d.name)))?;
                 Ok(Field {
                     components: d.elem.num_comp() as usize,
+                    component_names: names.get(&d.name).cloned().unwrap_or_default(),
                     name: d.name,
                     values,
                 })
@@ -271,10 +426,11 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
             .collect()
     };
     let frame = Frame {
-        point_data: fields(piece.data.point, "point")?,
-        cell_data: fields(piece.data.cell, "cell")?,
+        point_data: fields(piece.data.point, "point", &point_names)?,
+        cell_data: fields(piece.data.cell, "cell", &cell_names)?,
         points,
         hexes,
+        quads,
     };
     frame
         .validate()
@@ -333,6 +489,7 @@ mod tests {
         Frame {
             points,
             hexes: vec![hex(0), hex(1)],
+            quads: Vec::new(),
             point_data: vec![
                 Field::scalar("temperature", temperature),
                 Field::vector("displacement", &displacement),
@@ -340,6 +497,10 @@ mod tests {
             cell_data: vec![
                 Field::scalar("pressure", vec![1.0 / 3.0, -2.0e-17]),
                 Field::vector("traction", &[[0.1, 0.2, 0.3], [1e300, -5e-324, 0.0]]),
+                Field::symmetric_tensor(
+                    "stress",
+                    (0..12).map(|i| i as f64 / 7.0 - 1.0).collect(),
+                ),
             ],
         }
     }
@@ -381,6 +542,45 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
     }
 
+    /// Component names are on the right arrays (a point and a cell field may share a name),
+    /// and quadrilaterals round-trip after the hexahedra.
+    #[test]
+    fn vtu_component_names_and_quads_round_trip() {
+        let dir = temp_dir("vtu-names");
+        let path = dir.join("named.vtu");
+        let mut frame = two_hex_frame();
+        frame.point_data.push(
+            Field::vector("stress", &vec![[1.0, 2.0, 3.0]; 12]).named_components(&["a", "b&c", "d"]),
+        );
+        frame.quads = vec![[0, 1, 7, 6], [1, 2, 8, 7]];
+        frame.cell_data = (frame.cell_data.into_iter())
+            .map(|mut f| {
+                let per = f.components;
+                let extra: Vec<f64> = (0..2 * per).map(|i| i as f64).collect();
+                f.values.extend(extra);
+                f
+            })
+            .collect();
+        write_vtu(&path, &frame).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("ComponentName0=\"xx\""), "{text}");
+        assert!(text.contains("ComponentName5=\"xz\""), "{text}");
+        assert!(text.contains("ComponentName1=\"b&amp;c\""), "{text}");
+        let back = read_vtu(&path).unwrap();
+        assert_eq!(back, frame);
+        assert_eq!(back.cell_data[2].component_names, SYMMETRIC_TENSOR_COMPONENTS);
+        assert_eq!(back.point_data[2].component_names, ["a", "b&c", "d"]);
+        assert_eq!(back.quads.len(), 2);
+        // vtkio's own reader still accepts the tags with the extra attributes.
+        assert!(Vtk::import(&path).is_ok());
+
+        let mut bad = two_hex_frame();
+        bad.cell_data[2].component_names.pop();
+        let err = write_vtu(&path, &bad).unwrap_err().to_string();
+        assert!(err.contains("component names") && err.contains("stress"), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     #[test]
     fn vtu_also_read_by_plain_vtkio_import() {
         // Independent of `read_vtu`: vtkio's own path-based importer must accept the file.
@@ -394,7 +594,7 @@ mod tests {
                 assert_eq!(p.num_points(), 12);
                 assert_eq!(p.cells.num_cells(), 2);
                 assert_eq!(p.data.point.len(), 2);
-                assert_eq!(p.data.cell.len(), 2);
+                assert_eq!(p.data.cell.len(), 3);
             }
             other => panic!("unexpected data set {other:?}"),
         }

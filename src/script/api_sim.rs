@@ -6,7 +6,7 @@ use super::HostOptions;
 use crate::contact::{Enforcement, FrameUpdate};
 use crate::contact::{FrictionInput, FrictionLaw};
 use crate::mesh::Mesh;
-use crate::output::RunOutput;
+use crate::output::{Cadence, Configuration, FrameOptions, RunOutput};
 use crate::solver::checkpoint::Checkpoint;
 use crate::solver::{AntiCycling, IncrementReport, Model, Simulation, SolverSettings, StepMode};
 use crate::tool::Tool;
@@ -21,7 +21,7 @@ pub struct SimState {
     model: Option<Model>,
     sim: Option<Simulation>,
     output: Option<RunOutput>,
-    output_every: usize,
+    frames: FrameKnobs,
     /// Write checkpoints/checkpoint_NNNN.json every this many increments (0: never).
     checkpoint_every: usize,
     host: Rc<HostOptions>,
@@ -251,13 +251,14 @@ impl SimState {
                 }
                 _ => None,
             };
-            if self.output_every > 0 || self.checkpoint_every > 0 {
+            if !self.frames.off || self.checkpoint_every > 0 {
                 let dir = self.host.out_dir.clone();
+                let options = self.frames.options(sim.model.settings.end_time);
                 let out = match &frame_times {
-                    Some(times) => lift(RunOutput::resume(&dir, &sim, times))?,
+                    Some(times) => lift(RunOutput::resume(&dir, &sim, options, times))?,
                     None => {
-                        let mut out = lift(RunOutput::create(&dir, &sim))?;
-                        if self.output_every > 0 {
+                        let mut out = lift(RunOutput::create(&dir, &sim, options))?;
+                        if !self.frames.off {
                             lift(out.write_frame(&sim))?;
                         }
                         out
@@ -351,6 +352,11 @@ impl SimState {
         if let Err(e) = out.record(sim) {
             note(e, &mut failures);
         }
+        if !self.frames.off {
+            if let Err(e) = out.write_last_frame(sim) {
+                note(e, &mut failures);
+            }
+        }
         let stop = crate::output::run::Stop {
             status: status.to_string(),
             reason: reason.to_string(),
@@ -402,7 +408,7 @@ impl SimState {
 
     /// Writes the increment's outputs and keeps each contact node's history.
     fn record_step(&mut self, report: &IncrementReport) -> ScriptResult<()> {
-        let every = self.output_every;
+        let frames_on = !self.frames.off;
         let sim = self.sim.as_ref().expect("started");
         if self.host.warnings {
             for w in &report.warnings {
@@ -414,8 +420,8 @@ impl SimState {
         }
         if let Some(out) = self.output.as_mut() {
             lift(out.record(sim))?;
-            if every > 0 && (report.index % every == 0 || sim.is_finished()) {
-                lift(out.write_frame(sim))?;
+            if frames_on {
+                lift(out.write_frame_if_due(sim, report.index))?;
             }
             let ck = self.checkpoint_every;
             if ck > 0 && (report.index % ck == 0 || sim.is_finished()) {
@@ -535,9 +541,30 @@ pub(super) fn interrupted(why: &str) -> Box<rhai::EvalAltResult> {
     ))
 }
 
+/// The frame settings of a script: `output_every` (0: no output), `output_interval`,
+/// `frame_points`. The cadence is resolved when the simulation starts (the default interval
+/// depends on the end time).
+#[derive(Clone, Copy, Debug, Default)]
+struct FrameKnobs {
+    off: bool,
+    cadence: Option<Cadence>,
+    points: Configuration,
+}
+
+impl FrameKnobs {
+    fn options(&self, end_time: f64) -> FrameOptions {
+        FrameOptions {
+            points: self.points,
+            cadence: self
+                .cadence
+                .unwrap_or_else(|| Cadence::default_for(end_time)),
+        }
+    }
+}
+
 /// Output knobs of the script layer.
 struct Knobs {
-    output_every: usize,
+    frames: FrameKnobs,
     checkpoint_every: usize,
     /// `--max-increments`: a larger `increments` setting is refused.
     max_increments: usize,
@@ -623,7 +650,21 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             "force_tolerance" => s.force_rel_tol = num("force_tolerance")?,
             "force_abs_tolerance" => s.force_abs_tol = num("force_abs_tolerance")?,
             "contact_tolerance" => s.contact_tol = num("contact_tolerance")?,
-            "output_every" => st.output_every = count("output_every")?,
+            "output_every" => {
+                let n = count("output_every")?;
+                st.frames.off = n == 0;
+                st.frames.cadence = (n > 0).then_some(Cadence::Increments(n));
+            }
+            "output_interval" => {
+                st.frames.off = false;
+                st.frames.cadence = Some(lift(Cadence::interval(num("output_interval")?))?);
+            }
+            "frame_points" => {
+                let name = v.clone().into_string().unwrap_or_default();
+                st.frames.points = lift(Configuration::parse(&name))
+                    .map_err(|_| format!("frame_points = '{name}' must be \"current\" or \"reference\""))
+                    .or_else(runtime_error)?;
+            }
             "extrapolate" => {
                 s.extrapolate = v
                     .as_bool()
@@ -690,7 +731,7 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, linear_solver, extrapolate, threads, kinematics, fbar, element, thickness_points, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
+                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, output_interval, frame_points, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, linear_solver, extrapolate, threads, kinematics, fbar, element, thickness_points, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
                 ))
             }
         }
@@ -723,7 +764,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         move |mesh: Mesh, mat: ScriptMaterial| -> ScriptResult<ScriptSim> {
             let mut model = lift(Model::new(mesh, mat.0))?;
             let mut knobs = Knobs {
-                output_every: 1,
+                frames: FrameKnobs::default(),
                 checkpoint_every: 0,
                 max_increments: h.limits.max_increments,
             };
@@ -732,7 +773,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 model: Some(model),
                 sim: None,
                 output: None,
-                output_every: knobs.output_every,
+                frames: knobs.frames,
                 checkpoint_every: knobs.checkpoint_every,
                 host: h.clone(),
                 started: None,
@@ -810,7 +851,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         |s: &mut ScriptSim, spec: Map| -> ScriptResult<()> {
             let mut st = s.borrow_mut();
             let mut knobs = Knobs {
-                output_every: st.output_every,
+                frames: st.frames,
                 checkpoint_every: st.checkpoint_every,
                 max_increments: st.host.limits.max_increments,
             };
@@ -823,7 +864,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 apply_settings(&mut settings, &mut knobs, &spec)?;
                 lift(sim.change_settings(settings))?;
             }
-            st.output_every = knobs.output_every;
+            st.frames = knobs.frames;
             st.checkpoint_every = knobs.checkpoint_every;
             Ok(())
         },
@@ -1151,7 +1192,7 @@ fn rollback(s: &mut ScriptSim, n: usize) -> ScriptResult<f64> {
     let kept = sim.history.len();
     node_log.retain(|(index, _, _)| *index <= kept);
     if let Some(out) = output.as_mut() {
-        lift(out.record(sim))?;
+        lift(out.rollback(sim))?;
     }
     Ok(t)
 }

@@ -353,6 +353,7 @@ impl Checkpoint {
                     ("lambda", n.lambda),
                     ("x_ref_local", n.x_ref_local),
                     ("normal", n.normal),
+                    ("slip_increment", n.slip_increment),
                 ] {
                     for (i, &x) in v.iter().enumerate() {
                         finite(&|| format!("{}[{i}]", field(name)), x)?;

@@ -239,6 +239,11 @@ impl Simulation {
         force_control::pose(&self.model, &self.dofs, c, self.time, &self.x).translation
     }
 
+    /// Pose of tool `c` at the committed state (schedule plus force-control offset).
+    pub fn tool_pose(&self, c: usize) -> crate::tool::Pose {
+        force_control::pose(&self.model, &self.dofs, c, self.time, &self.x)
+    }
+
     /// Total force on tool `c` at the committed state (sum of multipliers).
     pub fn tool_force(&self, c: usize) -> Vec3 {
         self.contact[c].iter().map(|s| s.lambda).sum()
@@ -589,6 +594,11 @@ impl Simulation {
                     s.gap = p.gap;
                     s.normal = p.normal;
                 }
+                s.slip_increment = if res.status.is_active() {
+                    res.slip_increment
+                } else {
+                    Vec3::zeros()
+                };
                 if res.status.is_active() {
                     let lambda_t = s.lambda - s.normal * s.lambda.dot(&s.normal);
                     s.work += lambda_t.dot(&res.slip_increment).max(0.0);

@@ -1,0 +1,252 @@
+//! What ParaView opens: frames.pvd lists, at every time, the blank (points in the current
+//! configuration, displacement alongside, named stress components) and the patch tools at
+//! their scheduled pose; frames follow the output cadence, and a rollback rewrites the
+//! series to the kept frames. Files are read back with an XML parser (quick-xml) and
+//! tribo's VTU reader, independently of how they were written.
+
+use std::path::{Path, PathBuf};
+use tribo::output::{read_vtu, Frame, SYMMETRIC_TENSOR_COMPONENTS};
+use tribo::script::{self, HostOptions};
+
+/// A 4 x 4 x 1 elastic block on a floor plane, under a biquadratic patch punch that moves
+/// by (0.3, 0, -0.1) t (linear path over t in [0, 1]) with Coulomb friction 0.1.
+/// `settings` and `steps` are Rhai inserted into the script.
+fn scene(settings: &str, steps: &str) -> String {
+    format!(
+        r#"
+let mesh = block([0.0, 0.0, 0.0], [4.0, 4.0, 1.0], [4, 4, 1]);
+let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
+sim.fix("z-", "xyz");
+let rows = [];
+for i in 0..3 {{
+    let row = [];
+    for j in 0..3 {{ row.push([-1.0 + 3.0 * i, -1.0 + 3.0 * j, 1.02]); }}
+    rows.push(row);
+}}
+let punch = tool("punch", patch_surface([bezier_patch(rows).flip()], [2.0, 2.0, 0.0]))
+    .path([[0.0, 0.0, 0.0, 0.0], [1.0, 0.3, 0.0, -0.1]])
+    .friction(coulomb(0.1));
+sim.add_tool(punch, "z+");
+sim.add_tool(tool("floor", plane([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])), "z-");
+sim.settings(#{{ end_time: 1.0, {settings} }});
+{steps}
+"#
+    )
+}
+
+/// The punch's translation at time t.
+fn punch_translation(t: f64) -> [f64; 3] {
+    [0.3 * t, 0.0, -0.1 * t]
+}
+
+fn run(name: &str, source: &str) -> PathBuf {
+    let base = std::env::temp_dir().join(format!("tribo-paraview-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&base);
+    std::fs::create_dir_all(&base).unwrap();
+    let file = base.join("scene.rhai");
+    std::fs::write(&file, source).unwrap();
+    let out = base.join("out");
+    let host = HostOptions {
+        out_dir: out.clone(),
+        progress: false,
+        ..HostOptions::default()
+    };
+    script::run_file(&file, &[], &host).unwrap();
+    out
+}
+
+/// One `<DataSet>` of a .pvd: (timestep, part, name, file).
+type Entry = (f64, usize, String, String);
+
+/// The datasets of a .pvd, parsed as XML.
+fn pvd_entries(path: &Path) -> Vec<Entry> {
+    use quick_xml::events::Event;
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut reader = quick_xml::Reader::from_str(&text);
+    let mut out = Vec::new();
+    let mut root_seen = false;
+    loop {
+        match reader.read_event().expect("well-formed XML") {
+            Event::Start(e) | Event::Empty(e) => {
+                let tag = String::from_utf8_lossy(e.name().as_ref()).to_string();
+                let attr = |key: &str| {
+                    e.attributes()
+                        .map(|a| a.unwrap())
+                        .find(|a| a.key.as_ref() == key.as_bytes())
+                        .map(|a| a.unescape_value().unwrap().to_string())
+                };
+                if tag == "VTKFile" {
+                    assert_eq!(attr("type").as_deref(), Some("Collection"));
+                    root_seen = true;
+                }
+                if tag == "DataSet" {
+                    out.push((
+                        attr("timestep").unwrap().parse().unwrap(),
+                        attr("part").unwrap().parse().unwrap(),
+                        attr("name").unwrap_or_default(),
+                        attr("file").unwrap(),
+                    ));
+                }
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    assert!(root_seen);
+    out
+}
+
+/// The distinct times of the series, in order.
+fn times(entries: &[Entry]) -> Vec<f64> {
+    entries.iter().filter(|e| e.1 == 0).map(|e| e.0).collect()
+}
+
+fn field<'a>(frame: &'a Frame, name: &str) -> &'a tribo::output::Field {
+    frame
+        .point_data
+        .iter()
+        .chain(&frame.cell_data)
+        .find(|f| f.name == name)
+        .unwrap_or_else(|| panic!("no field {name}"))
+}
+
+#[test]
+fn frames_show_the_deformed_blank_and_the_tools_at_their_pose() {
+    let out = run("pose", &scene("increments: 4", "sim.run();"));
+    let entries = pvd_entries(&out.join("frames.pvd"));
+    let t = times(&entries);
+    assert_eq!(t, vec![0.0, 0.25, 0.5, 0.75, 1.0], "{entries:?}");
+    // Each time: the blank (part 0) and the punch (part 1); the floor plane has no surface.
+    for (k, &time) in t.iter().enumerate() {
+        let parts: Vec<&Entry> = entries.iter().filter(|e| e.0 == time).collect();
+        assert_eq!(parts.len(), 2, "{parts:?}");
+        assert_eq!(
+            (parts[0].1, parts[0].3.as_str()),
+            (0, format!("frames/frame_{k:04}.vtu").as_str())
+        );
+        assert_eq!((parts[1].1, parts[1].2.as_str()), (1, "punch"));
+        assert_eq!(parts[1].3, format!("frames/frame_{k:04}_punch.vtu"));
+    }
+    let blank0 = read_vtu(&out.join(&entries[0].3)).unwrap();
+    let punch0 = read_vtu(&out.join(&entries[1].3)).unwrap();
+    // 8 x 8 quadrilaterals sample the biquadratic patch.
+    assert_eq!(punch0.quads.len(), 64);
+    assert!(punch0.hexes.is_empty());
+    let mut moved = 0.0f64;
+    for (k, &time) in t.iter().enumerate() {
+        let blank = read_vtu(&out.join(format!("frames/frame_{k:04}.vtu"))).unwrap();
+        let u = &field(&blank, "displacement").values;
+        // Current configuration: points = reference + displacement (round-off of one sum).
+        for (i, (p, x)) in blank.points.iter().zip(&blank0.points).enumerate() {
+            for c in 0..3 {
+                assert!(
+                    (p[c] - u[3 * i + c] - x[c]).abs() < 1e-14,
+                    "frame {k} node {i}: {p:?} - u != {x:?}"
+                );
+                moved = moved.max(u[3 * i + c].abs());
+            }
+        }
+        let stress = field(&blank, "stress");
+        assert_eq!(stress.components, 6);
+        assert_eq!(stress.component_names, SYMMETRIC_TENSOR_COMPONENTS);
+        // The punch: every vertex is the first frame's moved by the schedule's translation.
+        let punch = read_vtu(&out.join(format!("frames/frame_{k:04}_punch.vtu"))).unwrap();
+        let d = punch_translation(time);
+        assert_eq!(punch.quads, punch0.quads);
+        for (p, p0) in punch.points.iter().zip(&punch0.points) {
+            for c in 0..3 {
+                assert!((p[c] - p0[c] - d[c]).abs() < 1e-14, "frame {k}: {p:?}");
+            }
+        }
+    }
+    assert!(moved > 1e-3, "the blank deforms: largest |u| {moved}");
+    // At t = 0 the punch is the patch itself: its corner (-1, -1, 1.02).
+    assert!(punch0
+        .points
+        .iter()
+        .any(|p| p == &[-1.0, -1.0, 1.02]));
+
+    // Contact vectors of the last increment: |tangential_force| = lambda_t_norm, and the
+    // slip the sideways punch drags the top face through.
+    let last = read_vtu(&out.join("frames/frame_0004.vtu")).unwrap();
+    let ft = &field(&last, "tangential_force").values;
+    let lt = &field(&last, "lambda_t_norm").values;
+    let slip = &field(&last, "slip_increment").values;
+    let status = &field(&last, "contact_status").values;
+    let mut slipping = 0;
+    for i in 0..last.points.len() {
+        let norm = (ft[3 * i].powi(2) + ft[3 * i + 1].powi(2) + ft[3 * i + 2].powi(2)).sqrt();
+        assert!((norm - lt[i]).abs() <= 1e-9 * (1.0 + lt[i]), "node {i}");
+        if status[i] == 2.0 {
+            slipping += 1;
+            assert!(slip[3 * i].abs() > 0.0, "a slipping node slips: node {i}");
+        }
+        if status[i] == 0.0 {
+            assert_eq!(&slip[3 * i..3 * i + 3], &[0.0; 3], "no slip out of contact");
+        }
+    }
+    assert!(slipping > 0, "the punch drags the top face: {status:?}");
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["frames"], 5);
+    assert_eq!(summary["frame_points"], "current");
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+}
+
+#[test]
+fn reference_points_on_request() {
+    let out = run(
+        "reference",
+        &scene("increments: 2, frame_points: \"reference\"", "sim.run();"),
+    );
+    let first = read_vtu(&out.join("frames/frame_0000.vtu")).unwrap();
+    let last = read_vtu(&out.join("frames/frame_0002.vtu")).unwrap();
+    assert_eq!(first.points, last.points);
+    assert!(field(&last, "displacement").values.iter().any(|u| u.abs() > 1e-3));
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+}
+
+#[test]
+fn frames_follow_the_interval_not_the_increments() {
+    // Default: end_time / 20. 30 increments of 1/30 cross each multiple of 0.05 once.
+    let out = run("default", &scene("increments: 30", "sim.run();"));
+    let t = times(&pvd_entries(&out.join("frames.pvd")));
+    assert_eq!(t.len(), 21, "{t:?}");
+    assert!((t[20] - 1.0).abs() < 1e-12, "the end time is the last frame: {t:?}");
+    // One frame per interval [0.05 k, 0.05 (k + 1)): the first increment past each multiple.
+    let slot = |t: f64| (t / 0.05 + 1e-9).floor() as i64;
+    for (k, &time) in t.iter().enumerate() {
+        assert_eq!(slot(time), k as i64, "{t:?}");
+    }
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert_eq!(history.lines().count(), 1 + 30, "history keeps every increment");
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+
+    let out = run("interval", &scene("increments: 8, output_interval: 0.5", "sim.run();"));
+    assert_eq!(times(&pvd_entries(&out.join("frames.pvd"))), vec![0.0, 0.5, 1.0]);
+    assert!(!out.join("frames/frame_0003.vtu").exists());
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+}
+
+#[test]
+fn rollback_rewrites_the_series_to_the_kept_frames() {
+    let steps = "sim.step(); sim.step(); sim.step(); sim.rollback(2); sim.step();";
+    let out = run("rollback", &scene("increments: 4, output_every: 1", steps));
+    let entries = pvd_entries(&out.join("frames.pvd"));
+    // Frames at 0, 0.25, 0.5, 0.75; back to 0.25; one step to 0.5 again.
+    assert_eq!(times(&entries), vec![0.0, 0.25, 0.5]);
+    assert_eq!(entries.len(), 6, "blank and punch at each kept time");
+    for e in &entries {
+        assert!(out.join(&e.3).is_file(), "{e:?}");
+    }
+    assert!(!out.join("frames/frame_0003.vtu").exists());
+    assert!(!out.join("frames/frame_0003_punch.vtu").exists());
+    // The frame rewritten at 0.5 shows the punch there.
+    let punch0 = read_vtu(&out.join("frames/frame_0000_punch.vtu")).unwrap();
+    let punch2 = read_vtu(&out.join("frames/frame_0002_punch.vtu")).unwrap();
+    let d = punch_translation(0.5);
+    assert!((punch2.points[0][0] - punch0.points[0][0] - d[0]).abs() < 1e-14);
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+}
