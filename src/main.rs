@@ -76,14 +76,106 @@ enum Command {
         #[arg(long)]
         work_dir: Option<PathBuf>,
     },
-    /// Interactive stepping; loads SCRIPT's scene first if given.
+    /// A family of runs of SCRIPT, one per row of TABLE.csv (its columns become --set
+    /// NAME=VALUE), here on --jobs processes or written out for a cluster (--emit); then
+    /// `tribo sweep collect DIR` gathers the summaries into one CSV and charts.
+    Sweep(SweepArgs),
+    /// Interactive stepping: Rhai lines in one scope, TAB completion, :help NAME. Loads
+    /// SCRIPT's scene first if given, with stepping deferred (sim.run() returns at once; a
+    /// script that steps itself is loaded up to its first sim.step()).
     Repl {
+        /// A process script whose scene to load before the prompt.
         script: Option<PathBuf>,
+        /// Output folder of the simulations (default: out/<script name>, or out/repl).
         #[arg(long)]
         out: Option<PathBuf>,
         #[command(flatten)]
         limits: Limits,
     },
+}
+
+/// `tribo sweep SCRIPT TABLE.csv --out DIR` or `tribo sweep collect DIR`.
+#[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+struct SweepArgs {
+    #[command(subcommand)]
+    collect: Option<SweepCollect>,
+    /// The process script.
+    #[arg(required = true)]
+    script: Option<PathBuf>,
+    /// CSV table: a header of script variable names, one run per row (its values become
+    /// --set NAME=VALUE).
+    #[arg(required = true)]
+    table: Option<PathBuf>,
+    /// The sweep's folder: sweep.csv, runs/run_NNN/, logs/.
+    #[arg(long, required = true)]
+    out: Option<PathBuf>,
+    /// Runs at a time on this machine (or, with --emit parallel, in the printed command).
+    #[arg(long, default_value_t = 1)]
+    jobs: usize,
+    /// Do not run: write a Slurm job array (sweep.slurm) or a GNU parallel command file
+    /// (commands.txt) into the sweep's folder.
+    #[arg(long, value_name = "slurm|parallel")]
+    emit: Option<String>,
+    /// No line per finished run.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(Subcommand)]
+enum SweepCollect {
+    /// Gather every run's summary.json into DIR/collected.csv and chart outputs against a
+    /// parameter (DIR/chart_Y_vs_X.svg with its CSV).
+    Collect {
+        /// The sweep's folder.
+        dir: PathBuf,
+        /// Parameter on the x axis (default: the table's first column).
+        #[arg(long)]
+        x: Option<String>,
+        /// Output to chart (a column of collected.csv, e.g. newton_iterations or
+        /// tools.roller.final_force.0); repeat for several charts. Default:
+        /// newton_iterations.
+        #[arg(long)]
+        y: Vec<String>,
+        /// Parameter whose values make the chart's lines; repeatable (default: every
+        /// parameter but x).
+        #[arg(long)]
+        series: Vec<String>,
+    },
+}
+
+fn sweep(args: SweepArgs) -> tribo::Result<()> {
+    use tribo::sweep;
+    if let Some(SweepCollect::Collect { dir, x, y, series }) = args.collect {
+        let spec = sweep::collect::ChartSpec { x, y, series };
+        for file in sweep::collect::run(&dir, &spec)? {
+            println!("{}", file.display());
+        }
+        return Ok(());
+    }
+    let (Some(script), Some(table), Some(out)) = (args.script, args.table, args.out) else {
+        unreachable!("clap requires SCRIPT, TABLE and --out");
+    };
+    let this = std::env::current_exe()
+        .map_err(|e| tribo::Error::Input(format!("sweep: own binary: {e}")))?;
+    let plan = sweep::Sweep::new(&script, &table, &out, &this)?;
+    match args.emit {
+        Some(target) => {
+            let target = sweep::emit::Target::from_name(&target)?;
+            println!("{}", sweep::emit::write(&plan, target, args.jobs)?);
+            Ok(())
+        }
+        None => {
+            sweep::local::run(&plan, args.jobs, !args.quiet)?;
+            eprintln!(
+                "{} runs in {}; tribo sweep collect {} gathers their summaries",
+                plan.table.rows.len(),
+                plan.out.display(),
+                plan.out.display()
+            );
+            Ok(())
+        }
+    }
 }
 
 /// What a script may read and how much the run may use (see docs/script-api.md, "Limits").
@@ -189,6 +281,7 @@ fn main() -> ExitCode {
                 .map_err(|e| tribo::Error::Input(format!("bench: own binary: {e}")))?;
             tribo::bench::run(&opts, &this).map(|_| ())
         })(),
+        Command::Sweep(args) => sweep(args),
         Command::Repl {
             script,
             out,

@@ -4,10 +4,10 @@
 //! (stepping deferred). Driven through a pseudo-terminal by util-linux `script`, so that
 //! Ctrl-C is the terminal's: the byte 0x03 typed while a line runs becomes SIGINT.
 
-use std::io::{Read, Write};
+mod common;
+
+use common::pty::Session;
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdin, Command, Stdio};
-use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 const BIN: &str = env!("CARGO_BIN_EXE_tribo");
@@ -27,77 +27,6 @@ while !sim.finished() { sim.step(); }
 print("the loop ran while loading");
 "#;
 
-struct Session {
-    child: Child,
-    input: ChildStdin,
-    output: Arc<Mutex<String>>,
-}
-
-impl Session {
-    fn start(script: &Path, out: &Path) -> Session {
-        let command = format!("{BIN} repl {} --out {}", script.display(), out.display());
-        let mut child = Command::new("script")
-            .args(["-q", "-e", "-c", &command, "/dev/null"])
-            .env("TERM", "dumb")
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("util-linux `script` runs the REPL in a pseudo-terminal");
-        let input = child.stdin.take().unwrap();
-        let mut stdout = child.stdout.take().unwrap();
-        let output = Arc::new(Mutex::new(String::new()));
-        let sink = output.clone();
-        std::thread::spawn(move || {
-            let mut buf = [0u8; 4096];
-            while let Ok(n) = stdout.read(&mut buf) {
-                if n == 0 {
-                    break;
-                }
-                sink.lock()
-                    .unwrap()
-                    .push_str(&String::from_utf8_lossy(&buf[..n]));
-            }
-        });
-        Session {
-            child,
-            input,
-            output,
-        }
-    }
-
-    fn send(&mut self, bytes: &[u8]) {
-        self.input.write_all(bytes).unwrap();
-        self.input.flush().unwrap();
-    }
-
-    /// Waits until the output after byte `from` contains `text`; returns the end of the match.
-    fn expect(&self, from: usize, text: &str) -> usize {
-        let start = Instant::now();
-        loop {
-            {
-                let out = self.output.lock().unwrap();
-                if let Some(i) = out[from.min(out.len())..].find(text) {
-                    return from + i + text.len();
-                }
-                assert!(
-                    start.elapsed() < Duration::from_secs(300),
-                    "no {text:?} in the REPL's output:\n{}",
-                    &out[from.min(out.len())..]
-                );
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        }
-    }
-}
-
-impl Drop for Session {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
 fn history_rows(out: &Path) -> usize {
     std::fs::read_to_string(out.join("history.csv"))
         .map(|t| t.lines().count().saturating_sub(1))
@@ -113,7 +42,7 @@ fn ctrl_c_during_run_returns_to_the_prompt_and_stepping_goes_on() {
     let script = dir.join("drag.rhai");
     std::fs::write(&script, SCENE).unwrap();
     let out = dir.join("out");
-    let mut s = Session::start(&script, &out);
+    let mut s = Session::start(BIN, &script, &out, "dumb");
 
     // Loading stops at the loop's first sim.step(): nothing stepped.
     let at = s.expect(0, "up to its first sim.step() (line 11;");
@@ -155,15 +84,7 @@ fn ctrl_c_during_run_returns_to_the_prompt_and_stepping_goes_on() {
     // Increments of 0.01 in time: the next one ends at (converged + 1) / 100.
     let at = s.expect(at, &format!("\n{}\r", converged + 1));
     assert_eq!(history_rows(&out), converged + 1);
-    s.send(b":quit\r");
     let _ = at;
-    let start = Instant::now();
-    while s.child.try_wait().unwrap().is_none() {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the REPL did not quit"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    s.quit();
     let _ = std::fs::remove_dir_all(&dir);
 }

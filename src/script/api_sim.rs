@@ -215,6 +215,45 @@ impl Simulations {
         Ok(())
     }
 
+    /// Names of the tools of every simulation, in the order they were added (the REPL
+    /// completes them).
+    pub fn tool_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        for s in self.0.borrow().iter() {
+            if let Ok(st) = s.try_borrow() {
+                for name in tool_names(&st) {
+                    if !names.contains(&name) {
+                        names.push(name);
+                    }
+                }
+            }
+        }
+        names
+    }
+
+    /// Per tool of the one started simulation: its name and translation now (the REPL's
+    /// line after `sim.step()`); empty when no simulation or several have started.
+    pub fn tool_positions(&self) -> Vec<(String, [f64; 3])> {
+        let sims = self.0.borrow();
+        let started: Vec<_> = sims
+            .iter()
+            .filter_map(|s| s.try_borrow().ok())
+            .filter(|st| st.sim.is_some())
+            .collect();
+        let [st] = started.as_slice() else {
+            return Vec::new();
+        };
+        let sim = st.sim.as_ref().expect("started");
+        tool_names(st)
+            .into_iter()
+            .enumerate()
+            .map(|(c, name)| {
+                let p = sim.tool_position(c);
+                (name, [p[0], p[1], p[2]])
+            })
+            .collect()
+    }
+
     /// Times of the started simulations (for the REPL's messages).
     pub fn times(&self) -> Vec<f64> {
         self.0
@@ -591,6 +630,47 @@ fn flag(v: &Dynamic, key: &str) -> ScriptResult<bool> {
         .or_else(runtime_error)
 }
 
+/// Every key `sim.settings(#{ ... })` accepts (its error message and the REPL's completion
+/// list them from here).
+pub const SETTING_KEYS: &[&str] = &[
+    "increments",
+    "end_time",
+    "max_iterations",
+    "max_cutbacks",
+    "force_tolerance",
+    "force_abs_tolerance",
+    "contact_tolerance",
+    "output_every",
+    "output_interval",
+    "frame_points",
+    "checkpoint_every",
+    "curvature",
+    "frame",
+    "enforcement",
+    "friction_update",
+    "eliminate_multipliers",
+    "linear_solver",
+    "extrapolate",
+    "threads",
+    "kinematics",
+    "fbar",
+    "element",
+    "thickness_points",
+    "step_control",
+    "dt_min",
+    "dt_max",
+    "dt_initial",
+    "max_plastic_strain_increment",
+    "max_rotation_increment",
+    "max_slip_increment",
+    "target_iterations",
+    "step_growth",
+    "line_search",
+    "anti_cycling",
+    "cycle_flips",
+    "rollback_depth",
+];
+
 fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptResult<()> {
     for (key, v) in spec {
         let num = |what: &str| number(v, what);
@@ -731,7 +811,8 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             }
             other => {
                 return runtime_error(format!(
-                    "unknown setting '{other}' (known: increments, end_time, max_iterations, max_cutbacks, force_tolerance, force_abs_tolerance, contact_tolerance, output_every, output_interval, frame_points, checkpoint_every, curvature, frame, enforcement, friction_update, eliminate_multipliers, linear_solver, extrapolate, threads, kinematics, fbar, element, thickness_points, step_control, dt_min, dt_max, dt_initial, max_plastic_strain_increment, max_rotation_increment, max_slip_increment, target_iterations, step_growth, line_search, anti_cycling, cycle_flips, rollback_depth)"
+                    "unknown setting '{other}' (known: {})",
+                    SETTING_KEYS.join(", ")
                 ))
             }
         }

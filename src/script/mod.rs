@@ -15,7 +15,7 @@ pub mod limits;
 pub mod repl;
 mod stdlib;
 
-pub use api_sim::{ScriptSim, Simulations, DEFERRED};
+pub use api_sim::{ScriptSim, Simulations, DEFERRED, SETTING_KEYS};
 
 use crate::paths::ReadPolicy;
 use crate::{Error, Result};

@@ -1,6 +1,8 @@
 //! Shared set-up for the integration tests.
 #![allow(dead_code)]
 
+pub mod pty;
+
 use std::sync::Arc;
 use tribo::contact::FrictionLaw;
 use tribo::geometry::{RigidSurface, Vec3};

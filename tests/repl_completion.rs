@@ -1,0 +1,71 @@
+//! Issue 18, the REPL that helps, typed into a pseudo-terminal as a person would (rustyline
+//! in its editing mode, TERM=xterm): TAB completes methods from the engine's metadata, tool
+//! names inside a string and `sim.settings` keys; a statement left open continues on the
+//! next line; `:help NAME` shows the function's signature and its documented meaning;
+//! `:foo` is an unknown command; `sim.step()` prints its one-line summary.
+
+mod common;
+
+use common::pty::Session;
+
+const BIN: &str = env!("CARGO_BIN_EXE_tribo");
+
+const SCENE: &str = r#"
+let mesh = block([0, 0, 0], [16, 1, 2], [16, 1, 2]);
+let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
+let roller = tool("roller", cylinder([4.0, 0, 7.02], [0, 1, 0], 5.0))
+    .path([[0, 0, 0, 0], [1, 0, 0, -0.12], [3, 8.0, 0, -0.12]]).friction(coulomb(0.2));
+sim.add_tool(roller, "z+");
+sim.fix("z-", "xyz");
+sim.fix("y-", "y");
+sim.fix("y+", "y");
+sim.settings(#{ end_time: 3.0, increments: 30, output_every: 0 });
+sim.run();
+"#;
+
+#[test]
+fn completion_multi_line_input_and_help_in_a_terminal() {
+    let dir = std::env::temp_dir().join(format!("tribo-repl-completion-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("drag.rhai");
+    std::fs::write(&script, SCENE).unwrap();
+    let mut s = Session::start(BIN, &script, &dir.join("out"), "xterm");
+    let at = s.expect(0, "tribo> ");
+
+    // A method completed from its prefix (only `tool_force` starts with `tool_fo` on a
+    // Simulation), then the tool's name inside the string: without completion the line
+    // would call unknown names and print an error instead.
+    s.send(b"print(\"force components: \" + sim.tool_fo\t(\"ro\t\").len())\r");
+    let at = s.expect(at, "force components: 3");
+
+    // A settings key completed inside `sim.settings(#{ ... })`: an unknown key is refused.
+    s.send(b"sim.settings(#{ max_sl\t: 0.2 }); print(\"settings accepted\")\r");
+    let end = s.expect(at, "settings accepted");
+    assert!(!s.text(at, end).contains("unknown setting"));
+    let at = end;
+
+    // Multi-line input: the open statement waits for its end on the next line.
+    s.send(b"let answer = 40 +\r");
+    let at = s.expect(at, "...> ");
+    s.send(b"2;\r");
+    let at = s.expect(at, "tribo> ");
+    s.send(b"print(\"answer = \" + answer)\r");
+    let at = s.expect(at, "answer = 42");
+
+    // One function's help: the engine's signature and the reference's row.
+    s.send(b":help tool_force\r");
+    let at = s.expect(at, "tool_force(Simulation, string) -> array");
+    let at = s.expect(at, "sim.tool_force(name): total force the body exerts on the tool");
+
+    s.send(b":foo\r");
+    let at = s.expect(at, "unknown command ':foo'");
+
+    // One step: its summary line, not the report map.
+    s.send(b"sim.step()\r");
+    let at = s.expect(at, "increment 1: t = 0.1 (dt 0.1), roller at [0.0, 0.0, -0.012]");
+    let end = s.expect(at, "active nodes");
+    assert!(!s.text(at, end).contains("#{"), "the report map was echoed");
+    s.quit();
+    let _ = std::fs::remove_dir_all(&dir);
+}
