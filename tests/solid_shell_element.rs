@@ -235,7 +235,7 @@ fn solve_patch(
 }
 
 fn point_positions(el: &SolidShell, x: &[Vec3; 8]) -> Vec<Vec3> {
-    let (zeta, _) = tribo::element::solid_shell::gauss_legendre(el.thickness_points);
+    let (zeta, _) = tribo::element::solid_shell::thickness_rule(el.thickness_points);
     let g = 1.0 / 3f64.sqrt();
     let mut out = Vec::new();
     for z in zeta {
