@@ -111,7 +111,7 @@ fn bend(kind: ElementKind, layers: usize, elastic: bool) -> Curve {
     while !sim.is_finished() {
         let report = sim.step().unwrap();
         curve.iterations.push(report.iterations);
-        let eval = sim.evaluate_at(sim.time(), &sim.unknowns().to_vec()).unwrap();
+        let eval = sim.evaluate_at(sim.time(), sim.unknowns()).unwrap();
         let pos = |n: usize| sim.model.mesh.nodes[n] + sim.displacement(n);
         let centre = (pos(bottom) + pos(top)) * 0.5;
         let moment: f64 = end

@@ -239,8 +239,7 @@ fn point_positions(el: &SolidShell, x: &[Vec3; 8]) -> Vec<Vec3> {
     let g = 1.0 / 3f64.sqrt();
     let mut out = Vec::new();
     for z in zeta {
-        for q in 0..4 {
-            let c = HEX_CORNERS[q];
+        for c in &HEX_CORNERS[..4] {
             let n = shape_functions(&Vec3::new(c[0] * g, c[1] * g, z));
             out.push((0..8).map(|a| x[a] * n[a]).sum());
         }
