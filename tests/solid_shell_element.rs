@@ -235,12 +235,11 @@ fn solve_patch(
 }
 
 fn point_positions(el: &SolidShell, x: &[Vec3; 8]) -> Vec<Vec3> {
-    let (zeta, _) = tribo::element::solid_shell::gauss_legendre(el.thickness_points);
+    let (zeta, _) = tribo::element::solid_shell::thickness_rule(el.thickness_points);
     let g = 1.0 / 3f64.sqrt();
     let mut out = Vec::new();
     for z in zeta {
-        for q in 0..4 {
-            let c = HEX_CORNERS[q];
+        for c in &HEX_CORNERS[..4] {
             let n = shape_functions(&Vec3::new(c[0] * g, c[1] * g, z));
             out.push((0..8).map(|a| x[a] * n[a]).sum());
         }

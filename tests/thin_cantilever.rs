@@ -41,42 +41,6 @@ fn beam_theory(force: f64) -> f64 {
     force * LENGTH.powi(3) / (3.0 * bending_stiffness())
 }
 
-/// Tip deflection over length of the inextensible elastica under a dead end load, for the
-/// load parameter `alpha = P L² / EI`: with the slope `θ(s)` over the arc length `s / L`,
-/// `θ'' = -alpha cos θ`, `θ(0) = 0` (clamp), `θ'(1) = 0` (free end), deflection
-/// `∫ sin θ ds`. Shooting on `θ'(0)` (bisection; `θ'(1)` grows with it) with RK4 on 4000
-/// steps: error ~1e-14, far below what is compared here.
-fn elastica(alpha: f64) -> f64 {
-    let rhs = |y: [f64; 3]| [y[1], -alpha * y[0].cos(), y[0].sin()];
-    let shoot = |curvature: f64| {
-        let n = 4000;
-        let h = 1.0 / n as f64;
-        let add = |a: [f64; 3], b: [f64; 3], s: f64| std::array::from_fn(|i| a[i] + s * b[i]);
-        let mut y = [0.0, curvature, 0.0];
-        for _ in 0..n {
-            let k1 = rhs(y);
-            let k2 = rhs(add(y, k1, h / 2.0));
-            let k3 = rhs(add(y, k2, h / 2.0));
-            let k4 = rhs(add(y, k3, h));
-            y = std::array::from_fn(|i| {
-                y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            });
-        }
-        y
-    };
-    // θ'(0) = M(0)/EI lies in [0, alpha] (the lever arm is at most L).
-    let (mut lo, mut hi) = (0.0, alpha);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if shoot(mid)[1] > 0.0 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    shoot(0.5 * (lo + hi))[2]
-}
-
 fn cantilever(
     cells: [usize; 3],
     force: f64,
@@ -166,7 +130,7 @@ fn small_tip_forces_converge_in_one_quadratic_increment_to_the_small_strain_defl
         let w = tip(&sim);
         let alpha = force * LENGTH.powi(2) / bending_stiffness();
         let alpha_eff = alpha * w_small / beam_theory(force);
-        let geometric = elastica(alpha_eff) / (alpha_eff / 3.0) - 1.0;
+        let geometric = common::elastica(alpha_eff) / (alpha_eff / 3.0) - 1.0;
         let eps_max = sim
             .points()
             .iter()
@@ -225,8 +189,8 @@ fn large_tip_force_reaches_the_elastica_in_five_increments() {
     assert_eq!(increments, 5);
     let w = tip(&sim) / LENGTH;
     let alpha = force * LENGTH.powi(2) / bending_stiffness();
-    let exact = elastica(alpha);
-    let effective = elastica(alpha * small);
+    let exact = common::elastica(alpha);
+    let effective = common::elastica(alpha * small);
     println!(
         "100 N: w/L {w:.5}; elastica {exact:.5} (error {:.3e}; small-force error of the mesh \
          {:.3e}); elastica at the mesh's bending stiffness {effective:.5} (error {:.3e})",

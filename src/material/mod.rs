@@ -93,7 +93,7 @@ pub struct PointState {
 
 /// Number of element-level internal variables a [`PointState`] carries
 /// ([`PointState::enhanced`]).
-pub const ENHANCED_PARAMETERS: usize = 5;
+pub const ENHANCED_PARAMETERS: usize = 6;
 
 impl Default for PointState {
     /// The virgin state: stress- and strain-free, `F = I`.
