@@ -198,8 +198,29 @@ fn flip_reverses_normals_and_gaps() {
     assert!((p.gap - 1.81).abs() < 1e-12, "{p:?}");
 }
 
-fn refusal(name: &str, text: &str) -> String {
-    match faces_from_iges(name, text) {
+/// The global section's units: the same file in inches is 25.4 times larger.
+#[test]
+fn iges_units_come_from_the_global_section() {
+    let (_, text) = data("punch_nurbs.igs");
+    let inches = text.replacen(",1.,2,2HMM,", ",1.,1,2HIN,", 1);
+    assert_ne!(inches, text);
+    let mm = iges_tool("punch_nurbs.igs", &ImportOptions::default());
+    let faces = faces_from_iges("punch_in.igs", &inches).unwrap();
+    let big = tool_surface("punch_in.igs", faces, &ImportOptions::default()).unwrap();
+    for x in [Vec3::new(1.0, 2.0, -1.0), Vec3::new(40.0, 3.0, 20.0), Vec3::new(33.0, 33.0, 2.0)] {
+        let (p, q) = (mm.project(&x, None).unwrap(), big.project(&(x * 25.4), None).unwrap());
+        assert!((q.foot - p.foot * 25.4).norm() < 1e-9 && (q.gap - 25.4 * p.gap).abs() < 1e-9);
+    }
+    let bad = text.replacen(",1.,2,2HMM,", ",1.,0,2HMM,", 1);
+    let e = faces_from_iges("bad_units.igs", &bad).unwrap_err().to_string();
+    assert!(e.contains("bad_units.igs:4: global parameter 14 (units flag) = 0 is not an IGES unit"), "{e}");
+}
+
+type Reader = fn(&str, &str) -> tribo::Result<Vec<tribo::cad::Face>>;
+
+/// The message refusing `text` as read by `read` (reading or making the tool).
+fn refused_by(read: Reader, name: &str, text: &str) -> String {
+    match read(name, text) {
         Ok(faces) => match tool_surface(name, faces, &ImportOptions::default()) {
             Ok(_) => panic!("{name} was accepted"),
             Err(e) => e.to_string(),
@@ -265,14 +286,12 @@ fn bad_files_are_refused_naming_what_and_where() {
     assert!(e.contains(&format!("punch_nurbs.igs: face index = {count} must be < the file's face count {count}")), "{e}");
 }
 
+fn refusal(name: &str, text: &str) -> String {
+    refused_by(faces_from_iges, name, text)
+}
+
 fn step_refusal(name: &str, text: &str) -> String {
-    match faces_from_step(name, text) {
-        Ok(faces) => match tool_surface(name, faces, &ImportOptions::default()) {
-            Ok(_) => panic!("{name} was accepted"),
-            Err(e) => e.to_string(),
-        },
-        Err(e) => e.to_string(),
-    }
+    refused_by(faces_from_step, name, text)
 }
 
 #[test]

@@ -117,13 +117,24 @@ fn unit_to_mm(flag: i64, unit_name: &str) -> Option<f64> {
     })
 }
 
+/// Free-format IGES text split into parameters.
+struct Tokens {
+    tokens: Vec<Token>,
+    /// Texts of the Hollerith string tokens, in order.
+    strings: Vec<String>,
+    /// Character offset where each token starts.
+    starts: Vec<usize>,
+    /// The record delimiter was reached.
+    ended: bool,
+}
+
 /// Splits free-format IGES text into tokens up to the record delimiter. Hollerith strings
-/// `nH...` are skipped whole (they may hold delimiters). Returns the tokens and the texts
-/// of the string tokens.
-fn tokenize(text: &str, delimiter: char, record: char) -> (Vec<Token>, Vec<String>, bool) {
+/// `nH...` are skipped whole (they may hold delimiters).
+fn tokenize(text: &str, delimiter: char, record: char) -> Tokens {
     let chars: Vec<char> = text.chars().collect();
     let mut tokens = Vec::new();
     let mut strings = Vec::new();
+    let mut starts = Vec::new();
     let mut i = 0;
     let mut ended = false;
     while i <= chars.len() {
@@ -132,6 +143,7 @@ fn tokenize(text: &str, delimiter: char, record: char) -> (Vec<Token>, Vec<Strin
             i += 1;
         }
         let start = i;
+        starts.push(start);
         let mut hollerith = None;
         while i < chars.len() && chars[i] != delimiter && chars[i] != record {
             if chars[i] == 'H' {
@@ -168,7 +180,12 @@ fn tokenize(text: &str, delimiter: char, record: char) -> (Vec<Token>, Vec<Strin
         }
         i += 1;
     }
-    (tokens, strings, ended)
+    Tokens {
+        tokens,
+        strings,
+        starts,
+        ended,
+    }
 }
 
 /// Parameters of one entity, with the context for messages.
@@ -283,7 +300,6 @@ impl<'a> Iges<'a> {
             return Err(fail(1, "no global (G) section"));
         }
         let g: String = global.iter().map(|(_, s)| *s).collect();
-        let g_line = global[0].0;
         // Parameter and record delimiters: "1H," forms, or defaults when the field is empty.
         let mut chars = g.chars();
         let (delimiter, rest) = match (chars.next(), chars.next(), chars.next()) {
@@ -298,7 +314,17 @@ impl<'a> Iges<'a> {
                 _ => ';',
             }
         };
-        let (tokens, strings, _) = tokenize(&g, delimiter, record);
+        let Tokens {
+            tokens,
+            strings,
+            starts,
+            ..
+        } = tokenize(&g, delimiter, record);
+        // The G line holding global parameter k (1-based).
+        let line_of = |k: usize| {
+            let offset = starts.get(k - 1).copied().unwrap_or(0);
+            global[(offset / 72).min(global.len() - 1)].0
+        };
         // Parameter k (1-based) of the global section.
         let number = |k: usize| match tokens.get(k - 1) {
             Some(Token::Number(x)) => Some(*x),
@@ -316,13 +342,13 @@ impl<'a> Iges<'a> {
         };
         let unit = unit_to_mm(unit_flag, &unit_name).ok_or_else(|| {
             fail(
-                g_line,
+                line_of(14),
                 &format!("global parameter 14 (units flag) = {unit_flag} is not an IGES unit"),
             )
         })?;
         if !(model_scale.is_finite() && model_scale > 0.0) {
             return Err(fail(
-                g_line,
+                line_of(13),
                 &format!("global parameter 13 (model space scale) = {model_scale} must be > 0"),
             ));
         }
@@ -400,7 +426,7 @@ impl<'a> Iges<'a> {
         }
         let lines = &self.data[e.data - 1..e.data - 1 + e.data_lines];
         let text: String = lines.iter().map(|(_, s)| *s).collect();
-        let (tokens, _, ended) = tokenize(&text, self.delimiter, self.record);
+        let Tokens { tokens, ended, .. } = tokenize(&text, self.delimiter, self.record);
         let first_line = lines[0].0;
         if !ended {
             return Err(Error::Input(format!(
@@ -692,9 +718,15 @@ mod tests {
 
     #[test]
     fn hollerith_strings_may_hold_delimiters() {
-        let (tokens, strings, ended) = tokenize("1H,,1H;,4Ha,b;,2.5D1,,7;", ',', ';');
+        let Tokens {
+            tokens,
+            strings,
+            starts,
+            ended,
+        } = tokenize("1H,,1H;,4Ha,b;,2.5D1,,7;", ',', ';');
         assert!(ended);
         assert_eq!(strings, vec![",", ";", "a,b;"]);
+        assert_eq!(starts[3], 15);
         assert_eq!(tokens[3], Token::Number(25.0));
         assert_eq!(tokens[4], Token::Empty);
         assert_eq!(tokens[5], Token::Number(7.0));

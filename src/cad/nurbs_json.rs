@@ -19,7 +19,7 @@
 
 use super::Face;
 use crate::geometry::nurbs::{check_knots, curve_segments, NurbsSurface};
-use crate::geometry::patch_table::{array, kind, number, point, prefix};
+use crate::geometry::patch_table::{array, kind, number, point, prefix, rows_of};
 use crate::geometry::trim::{TrimRegion, TrimSegment};
 use crate::{Error, Result};
 use serde_json::Value;
@@ -103,26 +103,10 @@ fn face(v: &Value, name: &str) -> Result<Face> {
         numbers(&k[0], &format!("{name}.knots[0]"))?,
         numbers(&k[1], &format!("{name}.knots[1]"))?,
     ];
-    let points = array(field(v, "points", name)?, &format!("{name}.points"))?
-        .iter()
-        .enumerate()
-        .map(|(i, row)| {
-            array(row, &format!("{name}.points[{i}]"))?
-                .iter()
-                .enumerate()
-                .map(|(j, p)| point(p, &format!("{name}.points[{i}][{j}]")))
-                .collect::<Result<Vec<_>>>()
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let points = rows_of(field(v, "points", name)?, &format!("{name}.points"), point)?;
     let weights = match v.get("weights") {
         None => None,
-        Some(w) => Some(
-            array(w, &format!("{name}.weights"))?
-                .iter()
-                .enumerate()
-                .map(|(i, row)| numbers(row, &format!("{name}.weights[{i}]")))
-                .collect::<Result<Vec<_>>>()?,
-        ),
+        Some(w) => Some(rows_of(w, &format!("{name}.weights"), number)?),
     };
     let mut surface =
         NurbsSurface::new(degrees, knots, points, weights).map_err(|e| prefix(name, e))?;
