@@ -15,7 +15,14 @@ fn run(tag: &str, extra: &[&str]) -> Value {
         .current_dir(root)
         .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
         .arg(&out)
-        .args(["--set", "cells=8", "--set", "travel=6.0", "--set", "charts=false"])
+        .args([
+            "--set",
+            "cells=8",
+            "--set",
+            "travel=6.0",
+            "--set",
+            "charts=false",
+        ])
         .args(extra)
         .status()
         .expect("tribo runs");
@@ -30,7 +37,12 @@ fn cad_tools_give_the_built_in_draw_in_and_punch_force() {
     let builtin = run("builtin", &[]);
     let cad = run(
         "step",
-        &["--set", "cad_tools=\"../tests/data/cad\"", "--allow-read", "tests/data/cad"],
+        &[
+            "--set",
+            "cad_tools=\"../tests/data/cad\"",
+            "--allow-read",
+            "tests/data/cad",
+        ],
     );
     for s in [&builtin, &cad] {
         assert_eq!(s["status"], "finished", "{s}");

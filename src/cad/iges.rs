@@ -90,7 +90,9 @@ fn name(kind: i64) -> &'static str {
 }
 
 /// Surfaces a CAD exporter may write that are not read (a face on one is refused).
-const UNREAD_SURFACES: [i64; 13] = [108, 114, 118, 120, 122, 140, 143, 186, 190, 192, 194, 196, 198];
+const UNREAD_SURFACES: [i64; 13] = [
+    108, 114, 118, 120, 122, 140, 143, 186, 190, 192, 194, 196, 198,
+];
 
 /// Millimetres per unit of the global section's unit flag (IGES 5.3, parameter 14).
 fn unit_to_mm(flag: i64, unit_name: &str) -> Option<f64> {
@@ -198,7 +200,10 @@ struct Params<'a> {
 
 impl Params<'_> {
     fn fail(&self, message: String) -> Error {
-        Error::Input(format!("{}:{}: {}: {message}", self.source, self.line, self.at))
+        Error::Input(format!(
+            "{}:{}: {}: {message}",
+            self.source, self.line, self.at
+        ))
     }
 
     /// Parameter `i` (1 = the first after the entity type) as a number; empty means 0.
@@ -267,7 +272,10 @@ impl<'a> Iges<'a> {
                 ));
             };
             if s < current {
-                return Err(fail(line, &format!("{letter} line after the {} section", order[current])));
+                return Err(fail(
+                    line,
+                    &format!("{letter} line after the {} section", order[current]),
+                ));
             }
             current = s;
             sections[s].push((line, &raw[..72]));
@@ -282,7 +290,10 @@ impl<'a> Iges<'a> {
         }
         // T: "S      1G      4D    123P    456" - counts of each section's lines.
         let t = terminate[0].1;
-        for (k, (letter, lines)) in [('D', directory.len()), ('P', data.len())].iter().enumerate() {
+        for (k, (letter, lines)) in [('D', directory.len()), ('P', data.len())]
+            .iter()
+            .enumerate()
+        {
             let field = &t[8 * (k + 2)..8 * (k + 3)];
             let announced = field.get(1..).unwrap_or("").trim().parse::<usize>().ok();
             if field.starts_with(*letter) && announced != Some(*lines) {
@@ -364,20 +375,36 @@ impl<'a> Iges<'a> {
                 return Ok(0);
             }
             f.parse::<i64>().map_err(|_| {
-                fail(line, &format!("directory field {} ({what}) is not an integer", k + 1))
+                fail(
+                    line,
+                    &format!("directory field {} ({what}) is not an integer", k + 1),
+                )
             })
         };
         let mut entries = Vec::with_capacity(directory.len() / 2);
         for pair in directory.chunks(2) {
             let ((l1, d1), (l2, d2)) = (pair[0], pair[1]);
             let nonneg = |x: i64, line: usize, what: &str| -> Result<usize> {
-                usize::try_from(x).map_err(|_| fail(line, &format!("directory {what} = {x} must be >= 0")))
+                usize::try_from(x)
+                    .map_err(|_| fail(line, &format!("directory {what} = {x} must be >= 0")))
             };
             entries.push(Entry {
                 kind: field(d1, 0, l1, "entity type")?,
-                data: nonneg(field(d1, 1, l1, "parameter data pointer")?, l1, "parameter data pointer")?,
-                matrix: nonneg(field(d1, 6, l1, "transformation matrix")?, l1, "transformation matrix")?,
-                data_lines: nonneg(field(d2, 3, l2, "parameter line count")?, l2, "parameter line count")?,
+                data: nonneg(
+                    field(d1, 1, l1, "parameter data pointer")?,
+                    l1,
+                    "parameter data pointer",
+                )?,
+                matrix: nonneg(
+                    field(d1, 6, l1, "transformation matrix")?,
+                    l1,
+                    "transformation matrix",
+                )?,
+                data_lines: nonneg(
+                    field(d2, 3, l2, "parameter line count")?,
+                    l2,
+                    "parameter line count",
+                )?,
                 form: field(d2, 4, l2, "form number")?,
                 file_line: l1,
             });
@@ -394,7 +421,10 @@ impl<'a> Iges<'a> {
 
     /// The entry a directory pointer (odd D line number) names.
     fn entry(&self, pointer: i64, from: &Params, what: &str) -> Result<&Entry> {
-        let index = usize::try_from(pointer - 1).ok().filter(|i| i % 2 == 0).map(|i| i / 2);
+        let index = usize::try_from(pointer - 1)
+            .ok()
+            .filter(|i| i % 2 == 0)
+            .map(|i| i / 2);
         index.and_then(|i| self.entries.get(i)).ok_or_else(|| {
             from.fail(format!(
                 "{what} pointer {pointer} is not a directory entry (odd D line 1..{})",
@@ -700,8 +730,15 @@ fn arc(v: &[f64]) -> Vec<TrimSegment> {
     (0..n)
         .map(|k| {
             let start = a0 + 2.0 * h * k as f64;
-            let (p0, p1) = (if k == 0 { s } else { at(start, r) }, at(start + h, r / h.cos()));
-            let p2 = if k + 1 == n { e } else { at(start + 2.0 * h, r) };
+            let (p0, p1) = (
+                if k == 0 { s } else { at(start, r) },
+                at(start + h, r / h.cos()),
+            );
+            let p2 = if k + 1 == n {
+                e
+            } else {
+                at(start + 2.0 * h, r)
+            };
             let w = h.cos();
             TrimSegment::new(vec![
                 [p0[0], p0[1], 1.0],
