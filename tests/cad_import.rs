@@ -50,8 +50,10 @@ fn worst_difference(a: &dyn RigidSurface, b: &dyn RigidSurface, points: &[Vec3])
     let mut worst = [0.0f64; 3];
     for x in points {
         let (p, q): (Projection, Projection) = (
-            a.project(x, None).unwrap_or_else(|| panic!("no foot on {} for {x:?}", a.describe())),
-            b.project(x, None).unwrap_or_else(|| panic!("no foot on {} for {x:?}", b.describe())),
+            a.project(x, None)
+                .unwrap_or_else(|| panic!("no foot on {} for {x:?}", a.describe())),
+            b.project(x, None)
+                .unwrap_or_else(|| panic!("no foot on {} for {x:?}", b.describe())),
         );
         let d = [
             (p.foot - q.foot).norm(),
@@ -73,14 +75,21 @@ fn worst_difference(a: &dyn RigidSurface, b: &dyn RigidSurface, points: &[Vec3])
 
 /// Points at signed distance `[-2, 5]` mm along the reference surface's normal from random
 /// surface points that `keep` accepts.
-fn points_around(reference: &PatchSurface, n: usize, seed: u64, keep: impl Fn(&Vec3) -> bool) -> Vec<Vec3> {
+fn points_around(
+    reference: &PatchSurface,
+    n: usize,
+    seed: u64,
+    keep: impl Fn(&Vec3) -> bool,
+) -> Vec<Vec3> {
     let mut rng = Rng(seed);
     let patches = reference.patches();
     let mut out = Vec::with_capacity(n);
     while out.len() < n {
         let k = (rng.uniform(0.0, patches.len() as f64) as usize).min(patches.len() - 1);
         let e = patches[k].evaluate(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
-        let Some(normal) = patches[k].normal(&e) else { continue };
+        let Some(normal) = patches[k].normal(&e) else {
+            continue;
+        };
         if !keep(&e.point) {
             continue;
         }
@@ -118,7 +127,8 @@ fn punch_equals_the_builder(format: &str) {
 
 fn die_equals_the_builder(format: &str) {
     let imported = cad_tool(format, "die");
-    let reference = PatchSurface::new(die_patches(&DieSpec::numisheet93(), Extent::Full).unwrap()).unwrap();
+    let reference =
+        PatchSurface::new(die_patches(&DieSpec::numisheet93(), Extent::Full).unwrap()).unwrap();
     // The CAD die is a 160 x 160 block 58 deep; the builder's flat top ends at |x|, |y| = 80
     // and its wall at z = -58: compare away from the block's sides and bottom.
     let mut points = points_around(&reference, 10_000, 92, |p| {
@@ -156,7 +166,11 @@ fn no_foot_in_the_opening(format: &str) {
     let mut rng = Rng(94);
     let mut on_top = 0;
     for _ in 0..10_000 {
-        let x = Vec3::new(rng.uniform(-90.0, 90.0), rng.uniform(-90.0, 90.0), rng.uniform(-5.0, 10.0));
+        let x = Vec3::new(
+            rng.uniform(-90.0, 90.0),
+            rng.uniform(-90.0, 90.0),
+            rng.uniform(-5.0, 10.0),
+        );
         let p = die.project(&x, None).unwrap();
         if p.foot.z.abs() < 1e-12 {
             on_top += 1;
@@ -164,7 +178,8 @@ fn no_foot_in_the_opening(format: &str) {
                 !inside_opening(&Vec3::new(p.foot.x, p.foot.y, 0.0)) || {
                     let (ax, ay) = (p.foot.x.abs(), p.foot.y.abs());
                     // On the opening's rim (where the entry radius meets the top) both agree.
-                    (ax.max(ay) - 45.0).abs() < 1e-7 || ((ax - 25.0).hypot(ay - 25.0) - 20.0).abs() < 1e-7
+                    (ax.max(ay) - 45.0).abs() < 1e-7
+                        || ((ax - 25.0).hypot(ay - 25.0) - 20.0).abs() < 1e-7
                 },
                 "x = {x:?}: foot {:?} on the top face inside its opening",
                 p.foot
@@ -183,23 +198,70 @@ fn flip_reverses_normals_and_gaps() {
     let plain = iges_tool("punch_nurbs.igs", &ImportOptions::default());
     let flipped = iges_tool(
         "punch_nurbs.igs",
-        &ImportOptions { flip: true, ..Default::default() },
+        &ImportOptions {
+            flip: true,
+            ..Default::default()
+        },
     );
-    for x in [Vec3::new(0.0, 0.0, -1.0), Vec3::new(40.0, 3.0, 20.0), Vec3::new(33.0, 33.0, 2.0)] {
-        let (p, q) = (plain.project(&x, None).unwrap(), flipped.project(&x, None).unwrap());
+    for x in [
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::new(40.0, 3.0, 20.0),
+        Vec3::new(33.0, 33.0, 2.0),
+    ] {
+        let (p, q) = (
+            plain.project(&x, None).unwrap(),
+            flipped.project(&x, None).unwrap(),
+        );
         assert!(p.gap > 0.0, "{x:?} is outside the punch: {p:?}");
         assert!((p.gap + q.gap).abs() < 1e-12 && (p.normal + q.normal).norm() < 1e-12);
     }
     let moved = iges_tool(
         "punch_nurbs.igs",
-        &ImportOptions { translate: Vec3::new(0.0, 0.0, 0.81), faces: None, flip: false },
+        &ImportOptions {
+            translate: Vec3::new(0.0, 0.0, 0.81),
+            faces: None,
+            flip: false,
+        },
     );
     let p = moved.project(&Vec3::new(1.0, 2.0, -1.0), None).unwrap();
     assert!((p.gap - 1.81).abs() < 1e-12, "{p:?}");
 }
 
-fn refusal(name: &str, text: &str) -> String {
-    match faces_from_iges(name, text) {
+/// The global section's units: the same file in inches is 25.4 times larger.
+#[test]
+fn iges_units_come_from_the_global_section() {
+    let (_, text) = data("punch_nurbs.igs");
+    let inches = text.replacen(",1.,2,2HMM,", ",1.,1,2HIN,", 1);
+    assert_ne!(inches, text);
+    let mm = iges_tool("punch_nurbs.igs", &ImportOptions::default());
+    let faces = faces_from_iges("punch_in.igs", &inches).unwrap();
+    let big = tool_surface("punch_in.igs", faces, &ImportOptions::default()).unwrap();
+    for x in [
+        Vec3::new(1.0, 2.0, -1.0),
+        Vec3::new(40.0, 3.0, 20.0),
+        Vec3::new(33.0, 33.0, 2.0),
+    ] {
+        let (p, q) = (
+            mm.project(&x, None).unwrap(),
+            big.project(&(x * 25.4), None).unwrap(),
+        );
+        assert!((q.foot - p.foot * 25.4).norm() < 1e-9 && (q.gap - 25.4 * p.gap).abs() < 1e-9);
+    }
+    let bad = text.replacen(",1.,2,2HMM,", ",1.,0,2HMM,", 1);
+    let e = faces_from_iges("bad_units.igs", &bad)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("bad_units.igs:4: global parameter 14 (units flag) = 0 is not an IGES unit"),
+        "{e}"
+    );
+}
+
+type Reader = fn(&str, &str) -> tribo::Result<Vec<tribo::cad::Face>>;
+
+/// The message refusing `text` as read by `read` (reading or making the tool).
+fn refused_by(read: Reader, name: &str, text: &str) -> String {
+    match read(name, text) {
         Ok(faces) => match tool_surface(name, faces, &ImportOptions::default()) {
             Ok(_) => panic!("{name} was accepted"),
             Err(e) => e.to_string(),
@@ -216,63 +278,85 @@ fn bad_files_are_refused_naming_what_and_where() {
     let cut = lines[..lines.len() - 300].join("\n");
     let e = refusal("cut.igs", &cut);
     assert!(
-        e.contains(&format!("cut.igs:{}: the file ends without its terminate (T) section: it is truncated", lines.len() - 300)),
+        e.contains(&format!(
+            "cut.igs:{}: the file ends without its terminate (T) section: it is truncated",
+            lines.len() - 300
+        )),
         "{e}"
     );
     // A 144 whose surface pointer names a 126 curve (D line 11) instead of its 128.
-    let p_line = lines.iter().position(|l| l.starts_with("144,5,1,0,7;")).unwrap();
+    let p_line = lines
+        .iter()
+        .position(|l| l.starts_with("144,5,1,0,7;"))
+        .unwrap();
     let mut wrong = lines.clone();
     let replaced = lines[p_line].replacen("144,5,1,0,7; ", "144,11,1,0,7;", 1);
     wrong[p_line] = &replaced;
     let e = refusal("wrong.igs", &wrong.join("\n"));
     assert!(
-        e.contains("wrong.igs:") && e.contains("entity 144 (trimmed surface) at D line")
+        e.contains("wrong.igs:")
+            && e.contains("entity 144 (trimmed surface) at D line")
             && e.contains("its surface pointer names entity 126 (rational B-spline curve)"),
         "{e}"
     );
     // A damaged number in a surface's parameter data.
     let mut damaged = lines.clone();
-    let p128 = lines.iter().position(|l| l.starts_with("128,1,1,1,1,")).unwrap();
+    let p128 = lines
+        .iter()
+        .position(|l| l.starts_with("128,1,1,1,1,"))
+        .unwrap();
     let bad = lines[p128].replacen("128,1,1,1,1,", "128,1,1,x,1,", 1);
     damaged[p128] = &bad;
     let e = refusal("damaged.igs", &damaged.join("\n"));
     assert!(
-        e.contains(&format!("damaged.igs:{}: entity 128 (rational B-spline surface)", p128 + 1))
-            && e.contains("parameter 3 (M1, degree in u) is not a number"),
+        e.contains(&format!(
+            "damaged.igs:{}: entity 128 (rational B-spline surface)",
+            p128 + 1
+        )) && e.contains("parameter 3 (M1, degree in u) is not a number"),
         "{e}"
     );
     // Faces on analytic surfaces, as OCC writes them without the NURBS conversion.
     let (_, analytic) = data("punch_analytic.igs");
     let e = refusal("punch_analytic.igs", &analytic);
     assert!(
-        e.contains("punch_analytic.igs:") && e.contains("this surface type is not read")
+        e.contains("punch_analytic.igs:")
+            && e.contains("this surface type is not read")
             && e.contains("BRepBuilderAPI_NurbsConvert"),
         "{e}"
     );
     // Not IGES at all.
     let e = refusal("notes.igs", "punch and die\n");
-    assert!(e.contains("notes.igs:1: not a fixed-format ASCII IGES line"), "{e}");
+    assert!(
+        e.contains("notes.igs:1: not a fixed-format ASCII IGES line"),
+        "{e}"
+    );
     // A face index beyond the file's faces.
     let faces = faces_from_iges("punch_nurbs.igs", &good).unwrap();
     let count = faces.len();
     let e = tool_surface(
         "punch_nurbs.igs",
         faces,
-        &ImportOptions { faces: Some(vec![count]), ..Default::default() },
+        &ImportOptions {
+            faces: Some(vec![count]),
+            ..Default::default()
+        },
     )
     .unwrap_err()
     .to_string();
-    assert!(e.contains(&format!("punch_nurbs.igs: face index = {count} must be < the file's face count {count}")), "{e}");
+    assert!(
+        e.contains(&format!(
+            "punch_nurbs.igs: face index = {count} must be < the file's face count {count}"
+        )),
+        "{e}"
+    );
+}
+
+fn refusal(name: &str, text: &str) -> String {
+    refused_by(faces_from_iges, name, text)
 }
 
 fn step_refusal(name: &str, text: &str) -> String {
-    match faces_from_step(name, text) {
-        Ok(faces) => match tool_surface(name, faces, &ImportOptions::default()) {
-            Ok(_) => panic!("{name} was accepted"),
-            Err(e) => e.to_string(),
-        },
-        Err(e) => e.to_string(),
-    }
+    refused_by(faces_from_step, name, text)
 }
 
 #[test]
@@ -283,7 +367,10 @@ fn bad_step_files_are_refused_naming_what_and_where() {
     let e = step_refusal("cut.step", &cut);
     assert!(e.contains("cut.step:") && e.contains("truncated"), "{e}");
     // The first face's surface reference pointing at one of its points instead.
-    let face_line = lines.iter().position(|l| l.starts_with("#17 = ADVANCED_FACE(")).unwrap();
+    let face_line = lines
+        .iter()
+        .position(|l| l.starts_with("#17 = ADVANCED_FACE("))
+        .unwrap();
     let mut wrong = lines.clone();
     let replaced = lines[face_line].replacen(",#31,", ",#32,", 1);
     wrong[face_line] = &replaced;
@@ -295,7 +382,8 @@ fn bad_step_files_are_refused_naming_what_and_where() {
     let (_, analytic) = data("punch_analytic.step");
     let e = step_refusal("punch_analytic.step", &analytic);
     assert!(
-        e.contains("punch_analytic.step:") && e.contains("which is not read")
+        e.contains("punch_analytic.step:")
+            && e.contains("which is not read")
             && e.contains("BRepBuilderAPI_NurbsConvert"),
         "{e}"
     );

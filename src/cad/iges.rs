@@ -90,7 +90,9 @@ fn name(kind: i64) -> &'static str {
 }
 
 /// Surfaces a CAD exporter may write that are not read (a face on one is refused).
-const UNREAD_SURFACES: [i64; 13] = [108, 114, 118, 120, 122, 140, 143, 186, 190, 192, 194, 196, 198];
+const UNREAD_SURFACES: [i64; 13] = [
+    108, 114, 118, 120, 122, 140, 143, 186, 190, 192, 194, 196, 198,
+];
 
 /// Millimetres per unit of the global section's unit flag (IGES 5.3, parameter 14).
 fn unit_to_mm(flag: i64, unit_name: &str) -> Option<f64> {
@@ -117,13 +119,24 @@ fn unit_to_mm(flag: i64, unit_name: &str) -> Option<f64> {
     })
 }
 
+/// Free-format IGES text split into parameters.
+struct Tokens {
+    tokens: Vec<Token>,
+    /// Texts of the Hollerith string tokens, in order.
+    strings: Vec<String>,
+    /// Character offset where each token starts.
+    starts: Vec<usize>,
+    /// The record delimiter was reached.
+    ended: bool,
+}
+
 /// Splits free-format IGES text into tokens up to the record delimiter. Hollerith strings
-/// `nH...` are skipped whole (they may hold delimiters). Returns the tokens and the texts
-/// of the string tokens.
-fn tokenize(text: &str, delimiter: char, record: char) -> (Vec<Token>, Vec<String>, bool) {
+/// `nH...` are skipped whole (they may hold delimiters).
+fn tokenize(text: &str, delimiter: char, record: char) -> Tokens {
     let chars: Vec<char> = text.chars().collect();
     let mut tokens = Vec::new();
     let mut strings = Vec::new();
+    let mut starts = Vec::new();
     let mut i = 0;
     let mut ended = false;
     while i <= chars.len() {
@@ -132,6 +145,7 @@ fn tokenize(text: &str, delimiter: char, record: char) -> (Vec<Token>, Vec<Strin
             i += 1;
         }
         let start = i;
+        starts.push(start);
         let mut hollerith = None;
         while i < chars.len() && chars[i] != delimiter && chars[i] != record {
             if chars[i] == 'H' {
@@ -168,7 +182,12 @@ fn tokenize(text: &str, delimiter: char, record: char) -> (Vec<Token>, Vec<Strin
         }
         i += 1;
     }
-    (tokens, strings, ended)
+    Tokens {
+        tokens,
+        strings,
+        starts,
+        ended,
+    }
 }
 
 /// Parameters of one entity, with the context for messages.
@@ -181,7 +200,10 @@ struct Params<'a> {
 
 impl Params<'_> {
     fn fail(&self, message: String) -> Error {
-        Error::Input(format!("{}:{}: {}: {message}", self.source, self.line, self.at))
+        Error::Input(format!(
+            "{}:{}: {}: {message}",
+            self.source, self.line, self.at
+        ))
     }
 
     /// Parameter `i` (1 = the first after the entity type) as a number; empty means 0.
@@ -250,7 +272,10 @@ impl<'a> Iges<'a> {
                 ));
             };
             if s < current {
-                return Err(fail(line, &format!("{letter} line after the {} section", order[current])));
+                return Err(fail(
+                    line,
+                    &format!("{letter} line after the {} section", order[current]),
+                ));
             }
             current = s;
             sections[s].push((line, &raw[..72]));
@@ -265,7 +290,10 @@ impl<'a> Iges<'a> {
         }
         // T: "S      1G      4D    123P    456" - counts of each section's lines.
         let t = terminate[0].1;
-        for (k, (letter, lines)) in [('D', directory.len()), ('P', data.len())].iter().enumerate() {
+        for (k, (letter, lines)) in [('D', directory.len()), ('P', data.len())]
+            .iter()
+            .enumerate()
+        {
             let field = &t[8 * (k + 2)..8 * (k + 3)];
             let announced = field.get(1..).unwrap_or("").trim().parse::<usize>().ok();
             if field.starts_with(*letter) && announced != Some(*lines) {
@@ -283,7 +311,6 @@ impl<'a> Iges<'a> {
             return Err(fail(1, "no global (G) section"));
         }
         let g: String = global.iter().map(|(_, s)| *s).collect();
-        let g_line = global[0].0;
         // Parameter and record delimiters: "1H," forms, or defaults when the field is empty.
         let mut chars = g.chars();
         let (delimiter, rest) = match (chars.next(), chars.next(), chars.next()) {
@@ -298,7 +325,17 @@ impl<'a> Iges<'a> {
                 _ => ';',
             }
         };
-        let (tokens, strings, _) = tokenize(&g, delimiter, record);
+        let Tokens {
+            tokens,
+            strings,
+            starts,
+            ..
+        } = tokenize(&g, delimiter, record);
+        // The G line holding global parameter k (1-based).
+        let line_of = |k: usize| {
+            let offset = starts.get(k - 1).copied().unwrap_or(0);
+            global[(offset / 72).min(global.len() - 1)].0
+        };
         // Parameter k (1-based) of the global section.
         let number = |k: usize| match tokens.get(k - 1) {
             Some(Token::Number(x)) => Some(*x),
@@ -316,13 +353,13 @@ impl<'a> Iges<'a> {
         };
         let unit = unit_to_mm(unit_flag, &unit_name).ok_or_else(|| {
             fail(
-                g_line,
+                line_of(14),
                 &format!("global parameter 14 (units flag) = {unit_flag} is not an IGES unit"),
             )
         })?;
         if !(model_scale.is_finite() && model_scale > 0.0) {
             return Err(fail(
-                g_line,
+                line_of(13),
                 &format!("global parameter 13 (model space scale) = {model_scale} must be > 0"),
             ));
         }
@@ -338,20 +375,36 @@ impl<'a> Iges<'a> {
                 return Ok(0);
             }
             f.parse::<i64>().map_err(|_| {
-                fail(line, &format!("directory field {} ({what}) is not an integer", k + 1))
+                fail(
+                    line,
+                    &format!("directory field {} ({what}) is not an integer", k + 1),
+                )
             })
         };
         let mut entries = Vec::with_capacity(directory.len() / 2);
         for pair in directory.chunks(2) {
             let ((l1, d1), (l2, d2)) = (pair[0], pair[1]);
             let nonneg = |x: i64, line: usize, what: &str| -> Result<usize> {
-                usize::try_from(x).map_err(|_| fail(line, &format!("directory {what} = {x} must be >= 0")))
+                usize::try_from(x)
+                    .map_err(|_| fail(line, &format!("directory {what} = {x} must be >= 0")))
             };
             entries.push(Entry {
                 kind: field(d1, 0, l1, "entity type")?,
-                data: nonneg(field(d1, 1, l1, "parameter data pointer")?, l1, "parameter data pointer")?,
-                matrix: nonneg(field(d1, 6, l1, "transformation matrix")?, l1, "transformation matrix")?,
-                data_lines: nonneg(field(d2, 3, l2, "parameter line count")?, l2, "parameter line count")?,
+                data: nonneg(
+                    field(d1, 1, l1, "parameter data pointer")?,
+                    l1,
+                    "parameter data pointer",
+                )?,
+                matrix: nonneg(
+                    field(d1, 6, l1, "transformation matrix")?,
+                    l1,
+                    "transformation matrix",
+                )?,
+                data_lines: nonneg(
+                    field(d2, 3, l2, "parameter line count")?,
+                    l2,
+                    "parameter line count",
+                )?,
                 form: field(d2, 4, l2, "form number")?,
                 file_line: l1,
             });
@@ -368,7 +421,10 @@ impl<'a> Iges<'a> {
 
     /// The entry a directory pointer (odd D line number) names.
     fn entry(&self, pointer: i64, from: &Params, what: &str) -> Result<&Entry> {
-        let index = usize::try_from(pointer - 1).ok().filter(|i| i % 2 == 0).map(|i| i / 2);
+        let index = usize::try_from(pointer - 1)
+            .ok()
+            .filter(|i| i % 2 == 0)
+            .map(|i| i / 2);
         index.and_then(|i| self.entries.get(i)).ok_or_else(|| {
             from.fail(format!(
                 "{what} pointer {pointer} is not a directory entry (odd D line 1..{})",
@@ -400,7 +456,7 @@ impl<'a> Iges<'a> {
         }
         let lines = &self.data[e.data - 1..e.data - 1 + e.data_lines];
         let text: String = lines.iter().map(|(_, s)| *s).collect();
-        let (tokens, _, ended) = tokenize(&text, self.delimiter, self.record);
+        let Tokens { tokens, ended, .. } = tokenize(&text, self.delimiter, self.record);
         let first_line = lines[0].0;
         if !ended {
             return Err(Error::Input(format!(
@@ -674,8 +730,15 @@ fn arc(v: &[f64]) -> Vec<TrimSegment> {
     (0..n)
         .map(|k| {
             let start = a0 + 2.0 * h * k as f64;
-            let (p0, p1) = (if k == 0 { s } else { at(start, r) }, at(start + h, r / h.cos()));
-            let p2 = if k + 1 == n { e } else { at(start + 2.0 * h, r) };
+            let (p0, p1) = (
+                if k == 0 { s } else { at(start, r) },
+                at(start + h, r / h.cos()),
+            );
+            let p2 = if k + 1 == n {
+                e
+            } else {
+                at(start + 2.0 * h, r)
+            };
             let w = h.cos();
             TrimSegment::new(vec![
                 [p0[0], p0[1], 1.0],
@@ -692,9 +755,15 @@ mod tests {
 
     #[test]
     fn hollerith_strings_may_hold_delimiters() {
-        let (tokens, strings, ended) = tokenize("1H,,1H;,4Ha,b;,2.5D1,,7;", ',', ';');
+        let Tokens {
+            tokens,
+            strings,
+            starts,
+            ended,
+        } = tokenize("1H,,1H;,4Ha,b;,2.5D1,,7;", ',', ';');
         assert!(ended);
         assert_eq!(strings, vec![",", ";", "a,b;"]);
+        assert_eq!(starts[3], 15);
         assert_eq!(tokens[3], Token::Number(25.0));
         assert_eq!(tokens[4], Token::Empty);
         assert_eq!(tokens[5], Token::Number(7.0));

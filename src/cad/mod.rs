@@ -42,7 +42,11 @@ pub struct ImportOptions {
 
 /// The tool surface of the chosen faces (see the module docs). Errs naming the face whose
 /// surface is degenerate, and as [`PatchSurface::with_trims`] for inconsistent normals.
-pub fn tool_surface(source: &str, faces: Vec<Face>, options: &ImportOptions) -> Result<PatchSurface> {
+pub fn tool_surface(
+    source: &str,
+    faces: Vec<Face>,
+    options: &ImportOptions,
+) -> Result<PatchSurface> {
     let chosen: Vec<Face> = match &options.faces {
         None => faces,
         Some(list) => {
@@ -72,10 +76,7 @@ pub fn tool_surface(source: &str, faces: Vec<Face>, options: &ImportOptions) -> 
             .surface
             .to_bezier()
             .map_err(|e| Error::Input(format!("{source}: {}: {}", face.origin, strip(e))))?;
-        let region = face
-            .trim
-            .filter(|t| !t.is_rectangle(u, v))
-            .map(Arc::new);
+        let region = face.trim.filter(|t| !t.is_rectangle(u, v)).map(Arc::new);
         for piece in pieces {
             let mut patch = piece.patch.transformed(&identity, &options.translate);
             if options.flip != face.flip {

@@ -19,7 +19,7 @@
 
 use super::Face;
 use crate::geometry::nurbs::{check_knots, curve_segments, NurbsSurface};
-use crate::geometry::patch_table::{array, kind, number, point, prefix};
+use crate::geometry::patch_table::{array, kind, number, point, prefix, rows_of};
 use crate::geometry::trim::{TrimRegion, TrimSegment};
 use crate::{Error, Result};
 use serde_json::Value;
@@ -89,7 +89,11 @@ fn curve(v: &Value, name: &str) -> Result<Vec<TrimSegment>> {
 fn face(v: &Value, name: &str) -> Result<Face> {
     let d = array(field(v, "degree", name)?, &format!("{name}.degree"))?;
     if d.len() != 2 {
-        return Err(Error::input(&format!("{name}.degree"), kind(&v["degree"]), "must be [p, q]"));
+        return Err(Error::input(
+            &format!("{name}.degree"),
+            kind(&v["degree"]),
+            "must be [p, q]",
+        ));
     }
     let degrees = [
         degree(&d[0], &format!("{name}.degree[0]"))?,
@@ -97,44 +101,38 @@ fn face(v: &Value, name: &str) -> Result<Face> {
     ];
     let k = array(field(v, "knots", name)?, &format!("{name}.knots"))?;
     if k.len() != 2 {
-        return Err(Error::input(&format!("{name}.knots"), kind(&v["knots"]), "must be [U, V]"));
+        return Err(Error::input(
+            &format!("{name}.knots"),
+            kind(&v["knots"]),
+            "must be [U, V]",
+        ));
     }
     let knots = [
         numbers(&k[0], &format!("{name}.knots[0]"))?,
         numbers(&k[1], &format!("{name}.knots[1]"))?,
     ];
-    let points = array(field(v, "points", name)?, &format!("{name}.points"))?
-        .iter()
-        .enumerate()
-        .map(|(i, row)| {
-            array(row, &format!("{name}.points[{i}]"))?
-                .iter()
-                .enumerate()
-                .map(|(j, p)| point(p, &format!("{name}.points[{i}][{j}]")))
-                .collect::<Result<Vec<_>>>()
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let points = rows_of(field(v, "points", name)?, &format!("{name}.points"), point)?;
     let weights = match v.get("weights") {
         None => None,
-        Some(w) => Some(
-            array(w, &format!("{name}.weights"))?
-                .iter()
-                .enumerate()
-                .map(|(i, row)| numbers(row, &format!("{name}.weights[{i}]")))
-                .collect::<Result<Vec<_>>>()?,
-        ),
+        Some(w) => Some(rows_of(w, &format!("{name}.weights"), number)?),
     };
     let mut surface =
         NurbsSurface::new(degrees, knots, points, weights).map_err(|e| prefix(name, e))?;
     if let Some(r) = v.get("range") {
         let r = array(r, &format!("{name}.range"))?;
         if r.len() != 2 {
-            return Err(Error::input(&format!("{name}.range"), kind(&v["range"]), "must be [[u0, u1], [v0, v1]]"));
+            return Err(Error::input(
+                &format!("{name}.range"),
+                kind(&v["range"]),
+                "must be [[u0, u1], [v0, v1]]",
+            ));
         }
         let u = numbers(&r[0], &format!("{name}.range[0]"))?;
         let w = numbers(&r[1], &format!("{name}.range[1]"))?;
         if u.len() != 2 || w.len() != 2 {
-            return Err(Error::Input(format!("{name}.range must be [[u0, u1], [v0, v1]]")));
+            return Err(Error::Input(format!(
+                "{name}.range must be [[u0, u1], [v0, v1]]"
+            )));
         }
         surface = surface
             .restricted([u[0], u[1]], [w[0], w[1]])
@@ -148,7 +146,10 @@ fn face(v: &Value, name: &str) -> Result<Face> {
                 .enumerate()
                 .map(|(l, curves)| {
                     let mut segments = Vec::new();
-                    for (c, cv) in array(curves, &format!("{name}.trim[{l}]"))?.iter().enumerate() {
+                    for (c, cv) in array(curves, &format!("{name}.trim[{l}]"))?
+                        .iter()
+                        .enumerate()
+                    {
                         segments.extend(curve(cv, &format!("{name}.trim[{l}][{c}]"))?);
                     }
                     Ok(segments)
@@ -216,7 +217,12 @@ mod tests {
             let in_hole = (p.foot.x - 1.0).hypot(p.foot.y - 1.0) < 0.5 - 1e-9;
             assert!(!in_hole, "foot {:?} in the hole", p.foot);
         }
-        let untrimmed = PLATE.split("\"trim\"").next().unwrap().trim_end().trim_end_matches(',');
+        let untrimmed = PLATE
+            .split("\"trim\"")
+            .next()
+            .unwrap()
+            .trim_end()
+            .trim_end_matches(',');
         let untrimmed = format!("{untrimmed} }} ] }}");
         let faces = faces_from_json("plate.json", &untrimmed).unwrap();
         let whole = tool_surface("plate.json", faces, &ImportOptions::default()).unwrap();
@@ -228,12 +234,26 @@ mod tests {
     fn errors_name_the_face_and_entry() {
         let msg = |t: &str| faces_from_json("t.json", t).unwrap_err().to_string();
         let e = msg(&PLATE.replace("[[0, 0, 2, 4, 4]", "[[0, 0, 2, 4]"));
-        assert!(e.contains("t.json: faces[0]: nurbs u knot count = 4 must be control points + degree + 1 = 5"), "{e}");
+        assert!(
+            e.contains(
+                "t.json: faces[0]: nurbs u knot count = 4 must be control points + degree + 1 = 5"
+            ),
+            "{e}"
+        );
         let e = msg(&PLATE.replace("[0.5,0.5],[1,0.5]", "[0.5,0.5],[1,\"x\"]"));
-        assert!(e.contains("t.json: faces[0].trim[1][0].points[6] = a string must be a number"), "{e}");
+        assert!(
+            e.contains("t.json: faces[0].trim[1][0].points[6] = a string must be a number"),
+            "{e}"
+        );
         let e = msg(&PLATE.replace("[4,2],[0,2],[0,0]]", "[4,2],[0,2],[0,0.5]]"));
-        assert!(e.contains("t.json: faces[0].trim: trimming loop 0 segment 3: gap to the next segment"), "{e}");
+        assert!(
+            e.contains("t.json: faces[0].trim: trimming loop 0 segment 3: gap to the next segment"),
+            "{e}"
+        );
         let e = msg("{ \"faces\": [ { \"degree\": [1, 0] } ] }");
-        assert!(e.contains("faces[0].degree[1] = 0 must be an integer in 1..=64"), "{e}");
+        assert!(
+            e.contains("faces[0].degree[1] = 0 must be an integer in 1..=64"),
+            "{e}"
+        );
     }
 }

@@ -76,7 +76,8 @@ impl Lexer<'_> {
                 b'/' if self.bytes.get(self.at + 1) == Some(&b'*') => {
                     self.at += 2;
                     while self.at < self.bytes.len()
-                        && !(self.bytes[self.at] == b'*' && self.bytes.get(self.at + 1) == Some(&b'/'))
+                        && !(self.bytes[self.at] == b'*'
+                            && self.bytes.get(self.at + 1) == Some(&b'/'))
                     {
                         if self.bytes[self.at] == b'\n' {
                             self.line += 1;
@@ -138,7 +139,11 @@ impl Lexer<'_> {
                             self.at += 1;
                             return Ok(Value::List(items));
                         }
-                        _ => return Err(self.fail("expected ',' or ')' in a list: damaged or truncated")),
+                        _ => {
+                            return Err(
+                                self.fail("expected ',' or ')' in a list: damaged or truncated")
+                            )
+                        }
                     }
                 }
             }
@@ -192,7 +197,10 @@ impl Lexer<'_> {
             Some(c) if c == b'-' || c == b'+' || c.is_ascii_digit() => {
                 let start = self.at;
                 while self.at < self.bytes.len()
-                    && matches!(self.bytes[self.at], b'0'..=b'9' | b'.' | b'E' | b'e' | b'+' | b'-')
+                    && matches!(
+                        self.bytes[self.at],
+                        b'0'..=b'9' | b'.' | b'E' | b'e' | b'+' | b'-'
+                    )
                 {
                     self.at += 1;
                 }
@@ -212,7 +220,9 @@ impl Lexer<'_> {
                 };
                 Ok(Value::Typed(Box::new(single)))
             }
-            _ => Err(self.fail("an unexpected character in a parameter list: damaged or truncated")),
+            _ => {
+                Err(self.fail("an unexpected character in a parameter list: damaged or truncated"))
+            }
         }
     }
 
@@ -269,10 +279,14 @@ fn prefix_factor(p: &Value) -> Option<f64> {
 impl<'a> Step<'a> {
     fn parse(source: &'a str, text: &'a str) -> Result<Step<'a>> {
         let data = text.find("DATA;").ok_or_else(|| {
-            Error::Input(format!("{source}:1: no DATA section: not a STEP file (ISO 10303-21)"))
+            Error::Input(format!(
+                "{source}:1: no DATA section: not a STEP file (ISO 10303-21)"
+            ))
         })?;
         if !text[..data].contains("ISO-10303-21") {
-            return Err(Error::Input(format!("{source}:1: not a STEP file (no ISO-10303-21 header)")));
+            return Err(Error::Input(format!(
+                "{source}:1: not a STEP file (no ISO-10303-21 header)"
+            )));
         }
         let mut lex = Lexer {
             bytes: text.as_bytes(),
@@ -299,7 +313,9 @@ impl<'a> Step<'a> {
                     lex.expect(b'=')?;
                     let parts = lex.parts()?;
                     if instances.insert(id, Instance { parts, line }).is_some() {
-                        return Err(Error::Input(format!("{source}:{line}: instance #{id} is defined twice")));
+                        return Err(Error::Input(format!(
+                            "{source}:{line}: instance #{id} is defined twice"
+                        )));
                     }
                 }
                 Some(_) => {
@@ -339,9 +355,15 @@ impl<'a> Step<'a> {
                     .first()
                     .and_then(prefix_factor)
                     .map(|f| f * 1000.0)
-                    .ok_or_else(|| self.fail(id, "an SI length unit prefix that is not read".into()));
+                    .ok_or_else(|| {
+                        self.fail(id, "an SI length unit prefix that is not read".into())
+                    });
             }
-            if let Some((_, p)) = inst.parts.iter().find(|(n, _)| n == "CONVERSION_BASED_UNIT") {
+            if let Some((_, p)) = inst
+                .parts
+                .iter()
+                .find(|(n, _)| n == "CONVERSION_BASED_UNIT")
+            {
                 if let Some(Value::Text(name)) = p.first() {
                     match name.to_ascii_uppercase().as_str() {
                         "INCH" => return Ok(25.4),
@@ -350,7 +372,10 @@ impl<'a> Step<'a> {
                     }
                 }
             }
-            return Err(self.fail(id, "a length unit that is not read (read: SI units, inch, foot)".into()));
+            return Err(self.fail(
+                id,
+                "a length unit that is not read (read: SI units, inch, foot)".into(),
+            ));
         }
         Ok(1.0)
     }
@@ -373,7 +398,11 @@ impl<'a> Step<'a> {
 
     fn kind(&self, id: usize) -> String {
         self.instances.get(&id).map_or(String::new(), |i| {
-            i.parts.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(" ")
+            i.parts
+                .iter()
+                .map(|(n, _)| n.as_str())
+                .collect::<Vec<_>>()
+                .join(" ")
         })
     }
 
@@ -410,10 +439,15 @@ impl<'a> Step<'a> {
     /// Coordinates of a `CARTESIAN_POINT` (2 or 3 of them).
     fn point(&self, id: usize, from: usize) -> Result<Vec<f64>> {
         let p = self.part(id, "CARTESIAN_POINT").ok_or_else(|| {
-            self.fail(from, format!("its control point #{id} is not a CARTESIAN_POINT"))
+            self.fail(
+                from,
+                format!("its control point #{id} is not a CARTESIAN_POINT"),
+            )
         })?;
         let c = self.list(id, p.get(1), "coordinates")?;
-        c.iter().map(|x| self.number(id, Some(x), "coordinate")).collect()
+        c.iter()
+            .map(|x| self.number(id, Some(x), "coordinate"))
+            .collect()
     }
 
     /// Knots expanded from `(multiplicities)` and `(values)`.
@@ -421,13 +455,19 @@ impl<'a> Step<'a> {
         let m = self.list(id, mults, "knot multiplicities")?;
         let k = self.list(id, values, "knot values")?;
         if m.len() != k.len() {
-            return Err(self.fail(id, format!("{} knot multiplicities for {} knots", m.len(), k.len())));
+            return Err(self.fail(
+                id,
+                format!("{} knot multiplicities for {} knots", m.len(), k.len()),
+            ));
         }
         let mut out = Vec::new();
         for (mv, kv) in m.iter().zip(k) {
             let times = self.number(id, Some(mv), "knot multiplicity")?;
             if !(1.0..=64.0).contains(&times) || times.fract() != 0.0 {
-                return Err(self.fail(id, format!("knot multiplicity {times} is not an integer in 1..64")));
+                return Err(self.fail(
+                    id,
+                    format!("knot multiplicity {times} is not an integer in 1..64"),
+                ));
             }
             let x = self.number(id, Some(kv), "knot")?;
             out.extend(std::iter::repeat_n(x, times as usize));
@@ -447,13 +487,23 @@ impl<'a> Step<'a> {
     fn surface(&self, id: usize, face: usize) -> Result<NurbsSurface> {
         // Simple instance: name, du, dv, points, form, closed u, closed v, self-intersect,
         // u mults, v mults, u knots, v knots, spec. Complex: the same split in parts.
-        let (head, knots, weights) = if let Some(p) = self.part(id, "B_SPLINE_SURFACE_WITH_KNOTS").filter(|p| p.len() == 13) {
+        let (head, knots, weights) = if let Some(p) = self
+            .part(id, "B_SPLINE_SURFACE_WITH_KNOTS")
+            .filter(|p| p.len() == 13)
+        {
             (&p[1..4], &p[8..12], None)
-        } else if let (Some(b), Some(k)) = (self.part(id, "B_SPLINE_SURFACE"), self.part(id, "B_SPLINE_SURFACE_WITH_KNOTS")) {
+        } else if let (Some(b), Some(k)) = (
+            self.part(id, "B_SPLINE_SURFACE"),
+            self.part(id, "B_SPLINE_SURFACE_WITH_KNOTS"),
+        ) {
             if b.len() < 3 || k.len() < 4 {
                 return Err(self.fail(id, "too few parameters for a B-spline surface".into()));
             }
-            (&b[0..3], &k[0..4], self.part(id, "RATIONAL_B_SPLINE_SURFACE"))
+            (
+                &b[0..3],
+                &k[0..4],
+                self.part(id, "RATIONAL_B_SPLINE_SURFACE"),
+            )
         } else {
             return Err(self.fail(
                 face,
@@ -464,7 +514,10 @@ impl<'a> Step<'a> {
                 ),
             ));
         };
-        let degree = [self.degree(id, head.first())?, self.degree(id, head.get(1))?];
+        let degree = [
+            self.degree(id, head.first())?,
+            self.degree(id, head.get(1))?,
+        ];
         let rows = self.list(id, head.get(2), "control points")?;
         let mut points = Vec::with_capacity(rows.len());
         for row in rows {
@@ -509,11 +562,20 @@ impl<'a> Step<'a> {
                 .iter()
                 .map(|q| self.point(self.reference(id, Some(q), "point")?, id))
                 .collect::<Result<_>>()?;
-            return Ok(xy.windows(2).map(|w| TrimSegment::line([w[0][0], w[0][1]], [w[1][0], w[1][1]])).collect());
+            return Ok(xy
+                .windows(2)
+                .map(|w| TrimSegment::line([w[0][0], w[0][1]], [w[1][0], w[1][1]]))
+                .collect());
         }
-        let (head, knots, weights) = if let Some(p) = self.part(id, "B_SPLINE_CURVE_WITH_KNOTS").filter(|p| p.len() == 9) {
+        let (head, knots, weights) = if let Some(p) = self
+            .part(id, "B_SPLINE_CURVE_WITH_KNOTS")
+            .filter(|p| p.len() == 9)
+        {
             (&p[1..3], &p[6..8], None)
-        } else if let (Some(b), Some(k)) = (self.part(id, "B_SPLINE_CURVE"), self.part(id, "B_SPLINE_CURVE_WITH_KNOTS")) {
+        } else if let (Some(b), Some(k)) = (
+            self.part(id, "B_SPLINE_CURVE"),
+            self.part(id, "B_SPLINE_CURVE_WITH_KNOTS"),
+        ) {
             if b.len() < 2 || k.len() < 2 {
                 return Err(self.fail(id, "too few parameters for a B-spline curve".into()));
             }
@@ -544,7 +606,13 @@ impl<'a> Step<'a> {
                 .collect::<Result<_>>()?,
         };
         if w.len() != n || w.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
-            return Err(self.fail(id, format!("{} weights for {n} control points, all must be > 0", w.len())));
+            return Err(self.fail(
+                id,
+                format!(
+                    "{} weights for {n} control points, all must be > 0",
+                    w.len()
+                ),
+            ));
         }
         check_knots("curve", p, n, &knots).map_err(|e| self.fail(id, super::strip(e)))?;
         Ok(curve_segments(p, &knots, &uv, &w, 2, [knots[p], knots[n]])
@@ -556,7 +624,10 @@ impl<'a> Step<'a> {
     /// The pcurves on `surface` of an edge's curve, each as trimming segments.
     fn edge_pcurves(&self, edge: usize, surface: usize) -> Result<Vec<Vec<TrimSegment>>> {
         let e = self.part(edge, "EDGE_CURVE").ok_or_else(|| {
-            self.fail(edge, "an oriented edge whose edge is not an EDGE_CURVE".into())
+            self.fail(
+                edge,
+                "an oriented edge whose edge is not an EDGE_CURVE".into(),
+            )
         })?;
         let geometry = self.reference(edge, e.get(3), "edge geometry")?;
         let g = self
@@ -568,20 +639,30 @@ impl<'a> Step<'a> {
         let mut out = Vec::new();
         for a in self.list(geometry, g.get(2), "associated geometry")? {
             let pc = self.reference(geometry, Some(a), "associated geometry")?;
-            let Some(p) = self.part(pc, "PCURVE") else { continue };
+            let Some(p) = self.part(pc, "PCURVE") else {
+                continue;
+            };
             if self.reference(pc, p.get(1), "basis surface")? != surface {
                 continue;
             }
             let rep = self.reference(pc, p.get(2), "definitional representation")?;
-            let r = self.part(rep, "DEFINITIONAL_REPRESENTATION").ok_or_else(|| {
-                self.fail(pc, "its reference is not a DEFINITIONAL_REPRESENTATION".into())
-            })?;
+            let r = self
+                .part(rep, "DEFINITIONAL_REPRESENTATION")
+                .ok_or_else(|| {
+                    self.fail(
+                        pc,
+                        "its reference is not a DEFINITIONAL_REPRESENTATION".into(),
+                    )
+                })?;
             let items = self.list(rep, r.get(1), "items")?;
             let curve = self.reference(rep, items.first(), "curve")?;
             out.push(self.param_curve(curve)?);
         }
         if out.is_empty() {
-            return Err(self.fail(geometry, format!("no PCURVE on the face's surface #{surface}")));
+            return Err(self.fail(
+                geometry,
+                format!("no PCURVE on the face's surface #{surface}"),
+            ));
         }
         Ok(out)
     }
@@ -664,7 +745,10 @@ impl<'a> Step<'a> {
             });
         }
         if faces.is_empty() {
-            return Err(Error::Input(format!("{}: no ADVANCED_FACE in the file", self.source)));
+            return Err(Error::Input(format!(
+                "{}: no ADVANCED_FACE in the file",
+                self.source
+            )));
         }
         Ok(faces)
     }
@@ -682,10 +766,16 @@ mod tests {
         assert_eq!(s.instances[&1].parts.len(), 3);
         assert!(matches!(&s.instances[&2].parts[0].1[0], Value::Text(t) if t == "it's"));
         assert_eq!(s.instances[&3].line, 7);
-        let e = Step::parse("t.step", &text.replace("#3 = MEASURE(LENGTH_MEASURE(1.E-07),#1);\nENDSEC;\nEND-ISO-10303-21;\n", "#3 = MEASURE(LENGTH_"))
-            .err()
-            .unwrap()
-            .to_string();
+        let e = Step::parse(
+            "t.step",
+            &text.replace(
+                "#3 = MEASURE(LENGTH_MEASURE(1.E-07),#1);\nENDSEC;\nEND-ISO-10303-21;\n",
+                "#3 = MEASURE(LENGTH_",
+            ),
+        )
+        .err()
+        .unwrap()
+        .to_string();
         assert!(e.contains("t.step:7:"), "{e}");
     }
 }

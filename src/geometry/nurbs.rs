@@ -70,7 +70,11 @@ pub fn check_knots(what: &str, degree: usize, count: usize, knots: &[f64]) -> Re
     }
     for (i, k) in knots.iter().enumerate() {
         if !k.is_finite() {
-            return Err(Error::input(&format!("{what} knot [{i}]"), k, "must be finite"));
+            return Err(Error::input(
+                &format!("{what} knot [{i}]"),
+                k,
+                "must be finite",
+            ));
         }
         if i > 0 && *k < knots[i - 1] {
             return Err(Error::input(
@@ -90,7 +94,10 @@ pub fn check_knots(what: &str, degree: usize, count: usize, knots: &[f64]) -> Re
     }
     let mut i = degree + 1;
     while i < count {
-        let run = knots[i..count].iter().take_while(|&&k| k == knots[i]).count();
+        let run = knots[i..count]
+            .iter()
+            .take_while(|&&k| k == knots[i])
+            .count();
         if run > degree {
             return Err(Error::input(
                 &format!("{what} interior knot {} multiplicity", knots[i]),
@@ -107,7 +114,10 @@ pub fn check_knots(what: &str, degree: usize, count: usize, knots: &[f64]) -> Re
 /// flattened in `points`) sit on `knots` (Boehm's algorithm, see the module docs).
 fn insert_knot(p: usize, knots: &mut Vec<f64>, points: &mut Vec<f64>, dim: usize, t: f64) {
     let n = points.len() / dim;
-    let k = knots.iter().rposition(|&x| x <= t).expect("t inside the knots");
+    let k = knots
+        .iter()
+        .rposition(|&x| x <= t)
+        .expect("t inside the knots");
     let s = knots.iter().filter(|&&x| x == t).count();
     let mut out = Vec::with_capacity(points.len() + dim);
     for i in 0..=n {
@@ -349,9 +359,16 @@ impl NurbsSurface {
 pub fn basis(p: usize, knots: &[f64], count: usize, t: f64) -> (usize, Vec<f64>) {
     let t = t.clamp(knots[p], knots[count]);
     let k = if t >= knots[count] {
-        (p..count).rev().find(|&k| knots[k] < knots[k + 1]).unwrap_or(p)
+        (p..count)
+            .rev()
+            .find(|&k| knots[k] < knots[k + 1])
+            .unwrap_or(p)
     } else {
-        knots.iter().rposition(|&x| x <= t).unwrap().clamp(p, count - 1)
+        knots
+            .iter()
+            .rposition(|&x| x <= t)
+            .unwrap()
+            .clamp(p, count - 1)
     };
     let mut n = vec![0.0; p + 1];
     let (mut left, mut right) = (vec![0.0; p + 1], vec![0.0; p + 1]);
@@ -464,8 +481,13 @@ mod tests {
             .map(|i| vec![if i % 2 == 1 { FRAC_1_SQRT_2 } else { 1.0 }; 2])
             .collect();
         let ku = vec![0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0, 4.0];
-        let s = NurbsSurface::new([2, 1], [ku, vec![0.0, 0.0, 1.0, 1.0]], points, Some(weights))
-            .unwrap();
+        let s = NurbsSurface::new(
+            [2, 1],
+            [ku, vec![0.0, 0.0, 1.0, 1.0]],
+            points,
+            Some(weights),
+        )
+        .unwrap();
         let pieces = s.to_bezier().unwrap();
         assert_eq!(pieces.len(), 4);
         let mut rng = Rng::new(73);
@@ -491,27 +513,42 @@ mod tests {
             pts(3),
             None,
         ));
-        assert!(e.contains("nurbs u knot count = 5 must be control points + degree + 1 = 6"), "{e}");
+        assert!(
+            e.contains("nurbs u knot count = 5 must be control points + degree + 1 = 6"),
+            "{e}"
+        );
         let e = msg(NurbsSurface::new(
             [2, 1],
             [vec![0.0, 0.0, 0.0, 0.5, 0.4, 1.0, 1.0, 1.0], kv.clone()],
             pts(5),
             None,
         ));
-        assert!(e.contains("nurbs u knot [4] = 0.4 must be >= the previous knot 0.5"), "{e}");
+        assert!(
+            e.contains("nurbs u knot [4] = 0.4 must be >= the previous knot 0.5"),
+            "{e}"
+        );
         let e = msg(NurbsSurface::new(
             [2, 1],
-            [vec![0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0], kv.clone()],
+            [
+                vec![0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0],
+                kv.clone(),
+            ],
             pts(6),
             None,
         ));
-        assert!(e.contains("interior knot 0.5 multiplicity = 3 must be <= the degree 2"), "{e}");
+        assert!(
+            e.contains("interior knot 0.5 multiplicity = 3 must be <= the degree 2"),
+            "{e}"
+        );
         let e = msg(NurbsSurface::new(
             [1, 1],
             [kv.clone(), kv.clone()],
             pts(2),
             Some(vec![vec![1.0, 1.0], vec![1.0, -1.0]]),
         ));
-        assert!(e.contains("nurbs weight [1][1] = -1 must be finite and > 0"), "{e}");
+        assert!(
+            e.contains("nurbs weight [1][1] = -1 must be finite and > 0"),
+            "{e}"
+        );
     }
 }

@@ -110,6 +110,25 @@ pub(crate) fn point(v: &Value, what: &str) -> Result<Vec3> {
     ))
 }
 
+/// A table of rows (`what[i][j]`), each entry read by `entry`; errors name the entry.
+pub(crate) fn rows_of<T>(
+    v: &Value,
+    what: &str,
+    entry: impl Fn(&Value, &str) -> Result<T>,
+) -> Result<Vec<Vec<T>>> {
+    array(v, what)?
+        .iter()
+        .enumerate()
+        .map(|(i, row)| {
+            array(row, &format!("{what}[{i}]"))?
+                .iter()
+                .enumerate()
+                .map(|(j, x)| entry(x, &format!("{what}[{i}][{j}]")))
+                .collect()
+        })
+        .collect()
+}
+
 /// Patches (and the optional outside point) from the JSON text of a patch table; `source`
 /// (the file name) prefixes every error.
 pub fn patches_from_json(source: &str, text: &str) -> Result<(Vec<BezierPatch>, Option<Vec3>)> {
@@ -126,36 +145,10 @@ pub fn patches_from_json(source: &str, text: &str) -> Result<(Vec<BezierPatch>, 
         let rows = entry
             .get("points")
             .ok_or_else(|| Error::Input(format!("{source}: {name} has no \"points\"")))?;
-        let points = array(rows, &format!("{name}.points"))
-            .map_err(fail)?
-            .iter()
-            .enumerate()
-            .map(|(i, row)| {
-                array(row, &format!("{name}.points[{i}]"))?
-                    .iter()
-                    .enumerate()
-                    .map(|(j, p)| point(p, &format!("{name}.points[{i}][{j}]")))
-                    .collect::<Result<Vec<Vec3>>>()
-            })
-            .collect::<Result<Vec<_>>>()
-            .map_err(fail)?;
+        let points = rows_of(rows, &format!("{name}.points"), point).map_err(fail)?;
         let weights = match entry.get("weights") {
             None => None,
-            Some(w) => Some(
-                array(w, &format!("{name}.weights"))
-                    .map_err(fail)?
-                    .iter()
-                    .enumerate()
-                    .map(|(i, row)| {
-                        array(row, &format!("{name}.weights[{i}]"))?
-                            .iter()
-                            .enumerate()
-                            .map(|(j, x)| number(x, &format!("{name}.weights[{i}][{j}]")))
-                            .collect::<Result<Vec<f64>>>()
-                    })
-                    .collect::<Result<Vec<_>>>()
-                    .map_err(fail)?,
-            ),
+            Some(w) => Some(rows_of(w, &format!("{name}.weights"), number).map_err(fail)?),
         };
         let mut patch = patch_from_rows(&name, &points, weights.as_deref()).map_err(fail)?;
         match entry.get("flip") {

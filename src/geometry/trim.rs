@@ -206,12 +206,7 @@ impl TrimRegion {
     }
 
     fn strictly_inside(&self, u: f64, v: f64) -> bool {
-        let n: usize = self
-            .loops
-            .iter()
-            .flatten()
-            .map(|s| s.crossings(u, v))
-            .sum();
+        let n: usize = self.loops.iter().flatten().map(|s| s.crossings(u, v)).sum();
         n % 2 == 1
     }
 
@@ -293,7 +288,12 @@ mod tests {
                 let d = (-1..=1)
                     .flat_map(|a| (-1..=1).map(move |b| (a, b)))
                     .map(|(a, b)| {
-                        inside_rounded_square(hr[0], hr[1], u + a as f64 * 1e-8, v + b as f64 * 1e-8)
+                        inside_rounded_square(
+                            hr[0],
+                            hr[1],
+                            u + a as f64 * 1e-8,
+                            v + b as f64 * 1e-8,
+                        )
                     })
                     .collect::<Vec<_>>();
                 d.iter().any(|&x| x) && d.iter().any(|&x| !x)
@@ -317,7 +317,10 @@ mod tests {
         let mut open = rounded_square(10.0, 3.0);
         open.pop();
         let err = TrimRegion::new(vec![open]).unwrap_err().to_string();
-        assert!(err.contains("trimming loop 0 segment 6: gap to the next segment"), "{err}");
+        assert!(
+            err.contains("trimming loop 0 segment 6: gap to the next segment"),
+            "{err}"
+        );
         let rect = vec![
             TrimSegment::line([0.0, 0.0], [2.0, 0.0]),
             TrimSegment::line([2.0, 0.0], [2.0, 1.0]),

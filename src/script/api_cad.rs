@@ -3,9 +3,9 @@
 
 use super::api_scene::ScriptSurface;
 use super::convert::*;
+use crate::cad::ImportOptions;
 use crate::cad::{iges::faces_from_iges, nurbs_json::faces_from_json, step::faces_from_step};
 use crate::cad::{tool_surface, Face};
-use crate::cad::ImportOptions;
 use rhai::{Array, Engine, Map};
 use std::rc::Rc;
 use std::sync::Arc;
@@ -19,7 +19,9 @@ fn options(map: &Map, function: &str) -> ScriptResult<ImportOptions> {
                 let list = value
                     .clone()
                     .try_cast::<Array>()
-                    .ok_or_else(|| format!("{function} option faces must be an array of face indices"))
+                    .ok_or_else(|| {
+                        format!("{function} option faces must be an array of face indices")
+                    })
                     .or_else(runtime_error)?;
                 let mut faces = Vec::with_capacity(list.len());
                 for (k, f) in list.iter().enumerate() {
@@ -35,9 +37,9 @@ fn options(map: &Map, function: &str) -> ScriptResult<ImportOptions> {
                 out.faces = Some(faces);
             }
             "flip" => {
-                out.flip = value
-                    .as_bool()
-                    .or_else(|_| runtime_error(format!("{function} option flip must be true or false")))?
+                out.flip = value.as_bool().or_else(|_| {
+                    runtime_error(format!("{function} option flip must be true or false"))
+                })?
             }
             "translate" => {
                 let a = value
@@ -68,14 +70,20 @@ fn load(
 ) -> ScriptResult<ScriptSurface> {
     let (_, text) = lift(policy.read_to_string(path, what))?;
     let faces = lift(read(path, &text))?;
-    Ok(ScriptSurface(Arc::new(lift(tool_surface(path, faces, options))?)))
+    Ok(ScriptSurface(Arc::new(lift(tool_surface(
+        path, faces, options,
+    ))?)))
 }
 
 pub fn register(engine: &mut Engine, policy: Rc<crate::paths::ReadPolicy>) {
     for (function, what, read) in [
         ("tool_from_iges", "IGES file", faces_from_iges as Reader),
         ("tool_from_step", "STEP file", faces_from_step as Reader),
-        ("tool_from_nurbs_json", "NURBS JSON table", faces_from_json as Reader),
+        (
+            "tool_from_nurbs_json",
+            "NURBS JSON table",
+            faces_from_json as Reader,
+        ),
     ] {
         let p = policy.clone();
         engine.register_fn(function, move |path: &str| -> ScriptResult<ScriptSurface> {

@@ -1,0 +1,60 @@
+//! The square cup (scripts/square_cup.rhai, coarse mesh) with the punch and die read from
+//! the OpenCascade STEP exports (tests/data/cad) gives the built-in scene's answers: the
+//! tools agree to 1e-11 mm (tests/cad_import.rs), so draw-in and punch force agree to the
+//! Newton tolerance (1e-9 relative on forces); 1e-6 leaves room for different iterates.
+
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+
+fn run(tag: &str, extra: &[&str]) -> Value {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::env::temp_dir().join(format!("tribo_cad_cup_{tag}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let status = Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .current_dir(root)
+        .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
+        .arg(&out)
+        .args([
+            "--set",
+            "cells=8",
+            "--set",
+            "travel=6.0",
+            "--set",
+            "charts=false",
+        ])
+        .args(extra)
+        .status()
+        .expect("tribo runs");
+    assert!(status.success(), "square cup ({tag}) failed");
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    let _ = std::fs::remove_dir_all(&out);
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
+#[test]
+fn cad_tools_give_the_built_in_draw_in_and_punch_force() {
+    let builtin = run("builtin", &[]);
+    let cad = run(
+        "step",
+        &[
+            "--set",
+            "cad_tools=\"../tests/data/cad\"",
+            "--allow-read",
+            "tests/data/cad",
+        ],
+    );
+    for s in [&builtin, &cad] {
+        assert_eq!(s["status"], "finished", "{s}");
+    }
+    let peak = |s: &Value| s["punch_force_peak_n"].as_f64().unwrap();
+    let (a, b) = (peak(&builtin), peak(&cad));
+    assert!(a > 1000.0, "{a}");
+    assert!((a - b).abs() <= 1e-6 * a, "punch force peak {a} vs {b}");
+    for key in ["dx", "dy", "dd"] {
+        let d = |s: &Value| s["final_draw_in"][key].as_f64().unwrap();
+        let (a, b) = (d(&builtin), d(&cad));
+        assert!(a > 0.0, "{key}: {a}");
+        assert!((a - b).abs() <= 1e-6 * a, "draw-in {key}: {a} vs {b}");
+    }
+}
