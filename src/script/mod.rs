@@ -5,6 +5,7 @@
 //! and size limits, and output only below the run's output folder.
 
 mod api_charts;
+mod api_numbers;
 mod api_scene;
 mod api_sim;
 mod api_tools;
@@ -108,6 +109,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);
+    api_numbers::register(&mut engine);
     register_checks(&mut engine);
     engine
 }
