@@ -250,3 +250,68 @@ fn rollback_rewrites_the_series_to_the_kept_frames() {
     assert!((punch2.points[0][0] - punch0.points[0][0] - d[0]).abs() < 1e-14);
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
+
+/// history.csv names each dimensional column's unit and carries the model fraction;
+/// summary.json has both. Numbers stay exact (shortest round-trip text).
+#[test]
+fn history_names_units_and_the_model_fraction() {
+    let settings = r#"increments: 2, model_fraction: 0.25,
+        units: #{ length: "mm", force: "N", time: "mm" }"#;
+    let out = run("units", &scene(settings, "sim.run();"));
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let mut lines = history.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for name in [
+        "increment",
+        "time [mm]",
+        "dt [mm]",
+        "newton_iterations",
+        "max_slip_increment [mm]",
+        "max_rotation_increment [rad]",
+        "punch_force_z [N]",
+        "floor_frictional_dissipation [N mm]",
+        "tool_work [N mm]",
+        "energy_balance_error",
+        "model_fraction",
+    ] {
+        assert!(header.contains(&name), "{name} in {header:?}");
+    }
+    let fraction = header.iter().position(|h| *h == "model_fraction").unwrap();
+    let time = header.iter().position(|h| *h == "time [mm]").unwrap();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2);
+    assert!(rows.iter().all(|r| r[fraction] == 0.25));
+    assert_eq!(rows[1][time], 1.0);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["model_fraction"], 0.25);
+    assert_eq!(summary["units"]["force"], "N");
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+
+    // Without units the names are bare; a bad fraction or unit is refused by name.
+    let out = run("no-units", &scene("increments: 1", "sim.run();"));
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert!(history.lines().next().unwrap().contains(",punch_force_z,"));
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+    for (bad, what) in [
+        ("model_fraction: 4.0", "model_fraction"),
+        ("units: #{ force: \"N,m\" }", "units.force"),
+        ("units: #{ mass: \"kg\" }", "unknown unit 'mass'"),
+    ] {
+        let dir = std::env::temp_dir().join(format!("tribo-paraview-bad-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("bad.rhai");
+        std::fs::write(&file, scene(&format!("increments: 1, {bad}"), "")).unwrap();
+        let host = HostOptions {
+            out_dir: dir.join("out"),
+            ..HostOptions::default()
+        };
+        let err = script::run_file(&file, &[], &host).unwrap_err().to_string();
+        assert!(err.contains(what) && err.contains("bad.rhai:"), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

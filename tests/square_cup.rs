@@ -173,7 +173,12 @@ fn history(out: &Path) -> Vec<(usize, Vec<f64>)> {
     let text = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let column = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    // Column names carry their unit after a space: "punch_force_x [N]".
+    let column = |name: &str| {
+        (header.iter())
+            .position(|h| h.split(" [").next() == Some(name))
+            .expect(name)
+    };
     let iterations = column("newton_iterations");
     let forces: Vec<usize> = ["punch", "blankholder", "die"]
         .iter()

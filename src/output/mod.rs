@@ -26,7 +26,7 @@ pub mod run;
 pub use self::csv::HistoryCsv;
 pub use self::folder::{FolderLock, OutputFolder, LOCK_FILE};
 pub use self::pvd::{PvdEntry, PvdSeries};
-pub use self::run::{FrameOptions, RunOutput};
+pub use self::run::{OutputOptions, RunOutput, Units};
 pub use self::summary::{write_summary, SUMMARY_FILE};
 pub use self::blank_frame::{frame, Configuration};
 pub use self::cadence::{Cadence, DEFAULT_FRAMES};
@@ -78,6 +78,37 @@ pub(crate) fn fmt_f64(x: f64) -> String {
         format!("{x}")
     } else {
         format!("{x:e}")
+    }
+}
+
+/// `x` to `digits` significant digits (1 to 17), for messages: plain decimals for
+/// magnitudes from 1e-5 to 1e15, exponent form otherwise, trailing zeros dropped
+/// (`significant(0.1 + 0.2, 6)` is "0.3", `significant(-23.912345678, 6)` is "-23.9123").
+/// Files keep full precision ([`fmt_f64`]); this is for what people read.
+pub fn significant(x: f64, digits: usize) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    if !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = digits.clamp(1, 17);
+    let rounded = format!("{:.*e}", digits - 1, x);
+    let (mantissa, exponent) = rounded.split_once('e').expect("exponent form");
+    let exponent: i32 = exponent.parse().expect("integer exponent");
+    let trim = |s: &str| -> String {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s.to_string()
+        }
+    };
+    if (-5..15).contains(&exponent) {
+        let value: f64 = rounded.parse().expect("a number");
+        let decimals = (digits as i32 - 1 - exponent).max(0) as usize;
+        trim(&format!("{value:.decimals$}"))
+    } else {
+        format!("{}e{exponent}", trim(mantissa))
     }
 }
 
@@ -151,6 +182,24 @@ mod tests {
             fmt_f64(f64::NEG_INFINITY).parse::<f64>().unwrap(),
             f64::NEG_INFINITY
         );
+    }
+
+    #[test]
+    fn significant_digits_for_messages() {
+        assert_eq!(significant(0.1 + 0.2, 6), "0.3");
+        assert_eq!(significant(-23.912345678, 6), "-23.9123");
+        assert_eq!(significant(30.000000000000004, 6), "30");
+        assert_eq!(significant(9.9999996, 6), "10");
+        assert_eq!(significant(123456789.0, 6), "123457000");
+        assert_eq!(significant(1.5e-7, 6), "1.5e-7");
+        assert_eq!(significant(-2.0e20 / 3.0, 3), "-6.67e19");
+        assert_eq!(significant(0.000123456789, 3), "0.000123");
+        assert_eq!(significant(-0.0, 6), "0");
+        assert_eq!(significant(f64::NAN, 6), "NaN");
+        assert_eq!(significant(f64::NEG_INFINITY, 6), "-inf");
+        // Digits beyond 17 are clamped (17 round-trips every f64).
+        let x = 0.1 + 0.2;
+        assert_eq!(significant(x, 40).parse::<f64>().unwrap(), x);
     }
 
     #[test]

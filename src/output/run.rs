@@ -23,28 +23,79 @@ pub struct Stop {
     pub write_failures: Vec<String>,
 }
 
-/// What the frames hold and when they are written.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FrameOptions {
+/// The units of the script's numbers, for the column headers of history.csv (the engine
+/// itself is unit-free). An empty name leaves the columns of that dimension without a unit.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Units {
+    pub length: String,
+    pub force: String,
+    pub time: String,
+}
+
+/// Physical dimension of a history column.
+#[derive(Clone, Copy)]
+enum Dimension {
+    None,
+    Length,
+    Force,
+    Energy,
+    Time,
+    Angle,
+}
+
+impl Units {
+    fn of(&self, d: Dimension) -> String {
+        match d {
+            Dimension::None => String::new(),
+            Dimension::Length => self.length.clone(),
+            Dimension::Force => self.force.clone(),
+            Dimension::Time => self.time.clone(),
+            Dimension::Angle => "rad".into(),
+            Dimension::Energy if self.force.is_empty() || self.length.is_empty() => String::new(),
+            Dimension::Energy => format!("{} {}", self.force, self.length),
+        }
+    }
+
+    /// `name [unit]`, or `name` when the unit is unknown or the column has no dimension.
+    fn column(&self, name: &str, d: Dimension) -> String {
+        match self.of(d) {
+            u if u.is_empty() => name.to_string(),
+            u => format!("{name} [{u}]"),
+        }
+    }
+}
+
+/// What the frames hold, when they are written, and how history.csv and summary.json
+/// label their numbers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputOptions {
     /// Where the blank's points are: current (default) or reference configuration.
     pub points: Configuration,
     /// When frames are written.
     pub cadence: Cadence,
+    /// Units named in history.csv's header.
+    pub units: Units,
+    /// Fraction of the physical part the model is (1/4 for a quarter model with two planes
+    /// of symmetry): forces, works and energies are the model's.
+    pub model_fraction: f64,
 }
 
-impl FrameOptions {
-    /// The defaults for a run to `end_time`: current configuration, an interval cadence.
+impl OutputOptions {
+    /// The defaults for a run to `end_time`: current configuration, an interval cadence, no
+    /// units, the whole part.
     pub fn default_for(end_time: f64) -> Self {
-        FrameOptions {
+        OutputOptions {
             points: Configuration::Current,
             cadence: Cadence::default_for(end_time),
+            units: Units::default(),
+            model_fraction: 1.0,
         }
     }
 }
 
 pub struct RunOutput {
     folder: OutputFolder,
-    frames: FrameOptions,
+    frames: OutputOptions,
     pvd: PvdSeries,
     history: HistoryCsv,
     /// Entries a script added to summary.json (top level, beside the built-in ones).
@@ -54,7 +105,7 @@ pub struct RunOutput {
 }
 
 impl RunOutput {
-    pub fn create(dir: &Path, sim: &Simulation, frames: FrameOptions) -> Result<Self> {
+    pub fn create(dir: &Path, sim: &Simulation, frames: OutputOptions) -> Result<Self> {
         let folder = OutputFolder::create(dir)?;
         for (path, pid) in remove_stale_temporaries(folder.root()) {
             eprintln!(
@@ -63,36 +114,37 @@ impl RunOutput {
             );
         }
         let pvd = PvdSeries::new(folder.root(), "frames")?;
-        let mut columns: Vec<String> = [
-            "increment",
-            "time",
-            "dt",
-            "newton_iterations",
-            "cutbacks",
-            "force_residual_rel",
-            "contact_residual",
-            "active_nodes",
-            "slipping_nodes",
-            "rejected_steps",
-            "line_search_cuts",
-            "cycling_nodes",
-            "frozen_nodes",
-            "step_limit",
-            "next_dt",
-            "max_plastic_strain_increment",
-            "max_rotation_increment",
-            "max_slip_increment",
+        use Dimension::*;
+        let mut columns: Vec<(String, Dimension)> = [
+            ("increment", None),
+            ("time", Time),
+            ("dt", Time),
+            ("newton_iterations", None),
+            ("cutbacks", None),
+            ("force_residual_rel", None),
+            ("contact_residual", None),
+            ("active_nodes", None),
+            ("slipping_nodes", None),
+            ("rejected_steps", None),
+            ("line_search_cuts", None),
+            ("cycling_nodes", None),
+            ("frozen_nodes", None),
+            ("step_limit", None),
+            ("next_dt", Time),
+            ("max_plastic_strain_increment", None),
+            ("max_rotation_increment", Angle),
+            ("max_slip_increment", Length),
         ]
         .iter()
-        .map(|s| s.to_string())
+        .map(|(s, d)| (s.to_string(), *d))
         .collect();
         for c in &sim.model.contacts {
             for axis in ["x", "y", "z"] {
-                columns.push(format!("{}_force_{axis}", c.tool.name));
+                columns.push((format!("{}_force_{axis}", c.tool.name), Force));
             }
         }
         for c in &sim.model.contacts {
-            columns.push(format!("{}_frictional_dissipation", c.tool.name));
+            columns.push((format!("{}_frictional_dissipation", c.tool.name), Energy));
         }
         for c in sim
             .model
@@ -100,7 +152,7 @@ impl RunOutput {
             .iter()
             .filter(|c| c.tool.force_control.is_some())
         {
-            columns.push(format!("{}_offset", c.tool.name));
+            columns.push((format!("{}_offset", c.tool.name), Length));
         }
         for name in [
             "tool_work",
@@ -108,10 +160,14 @@ impl RunOutput {
             "support_work",
             "elastic_energy",
             "plastic_dissipation",
-            "energy_balance_error",
         ] {
-            columns.push(name.to_string());
+            columns.push((name.to_string(), Energy));
         }
+        columns.push(("energy_balance_error".into(), None));
+        columns.push(("model_fraction".into(), None));
+        let columns: Vec<String> = (columns.iter())
+            .map(|(name, d)| frames.units.column(name, *d))
+            .collect();
         let history = HistoryCsv::create(folder.resolve_for_write("history.csv")?, &columns)?;
         Ok(RunOutput {
             folder,
@@ -129,7 +185,7 @@ impl RunOutput {
     pub fn resume(
         dir: &Path,
         sim: &Simulation,
-        frames: FrameOptions,
+        frames: OutputOptions,
         frame_times: &[f64],
     ) -> Result<Self> {
         let mut out = RunOutput::create(dir, sim, frames)?;
@@ -228,6 +284,7 @@ impl RunOutput {
             e.elastic_energy,
             e.plastic_dissipation,
             e.relative_error,
+            self.frames.model_fraction,
         ]);
         self.history.append(&row)
     }
@@ -248,9 +305,9 @@ impl RunOutput {
         files
     }
 
-    /// The frame options of this run.
-    pub fn frame_options(&self) -> FrameOptions {
-        self.frames
+    /// The output options of this run.
+    pub fn options(&self) -> &OutputOptions {
+        &self.frames
     }
 
     /// Writes the committed state as frames/frame_NNNN.vtu (the blank) and
@@ -428,6 +485,12 @@ impl RunOutput {
             "frames": self.frame_times.len(),
             "frame_cadence": self.frames.cadence.describe(),
             "frame_points": self.frames.points.name(),
+            "model_fraction": self.frames.model_fraction,
+            "units": {
+                "length": self.frames.units.length,
+                "force": self.frames.units.force,
+                "time": self.frames.units.time,
+            },
             "rejected_steps": sim.history.iter().map(|r| r.rejected).sum::<usize>(),
             "line_search_cuts": sim.history.iter().map(|r| r.line_search_cuts).sum::<usize>(),
             "increments_with_cycling": sim.history.iter().filter(|r| !r.cycling.is_empty()).count(),

@@ -6,7 +6,7 @@ use super::HostOptions;
 use crate::contact::{Enforcement, FrameUpdate};
 use crate::contact::{FrictionInput, FrictionLaw};
 use crate::mesh::Mesh;
-use crate::output::{Cadence, Configuration, FrameOptions, RunOutput};
+use crate::output::{Cadence, Configuration, OutputOptions, RunOutput, Units};
 use crate::solver::checkpoint::Checkpoint;
 use crate::solver::{AntiCycling, IncrementReport, Model, Simulation, SolverSettings, StepMode};
 use crate::tool::Tool;
@@ -405,7 +405,12 @@ impl SimState {
         if let Err(e) = out.write_stop_summary(sim, wall, &stop) {
             eprintln!("warning: {e}");
         }
-        saved.map(|path| format!("last converged state (t = {}) saved in {path}", sim.time()))
+        saved.map(|path| {
+            format!(
+                "last converged state (t = {}) saved in {path}",
+                crate::output::significant(sim.time(), 6)
+            )
+        })
     }
 
     /// What the script keeps (`sim.keep`), as checkpoints store it.
@@ -448,12 +453,14 @@ impl SimState {
     /// Writes the increment's outputs and keeps each contact node's history.
     fn record_step(&mut self, report: &IncrementReport) -> ScriptResult<()> {
         let frames_on = !self.frames.off;
+        let fmt = |x: f64| crate::output::significant(x, 6);
         let sim = self.sim.as_ref().expect("started");
         if self.host.warnings {
             for w in &report.warnings {
                 eprintln!(
                     "warning: increment {} (t = {}): {w}",
-                    report.index, report.time
+                    report.index,
+                    fmt(report.time)
                 );
             }
         }
@@ -580,25 +587,72 @@ pub(super) fn interrupted(why: &str) -> Box<rhai::EvalAltResult> {
     ))
 }
 
-/// The frame settings of a script: `output_every` (0: no output), `output_interval`,
-/// `frame_points`. The cadence is resolved when the simulation starts (the default interval
-/// depends on the end time).
-#[derive(Clone, Copy, Debug, Default)]
+/// The output settings of a script: `output_every` (0: no output), `output_interval`,
+/// `frame_points`, `units`, `model_fraction`. The cadence is resolved when the simulation
+/// starts (the default interval depends on the end time).
+#[derive(Clone, Debug)]
 struct FrameKnobs {
     off: bool,
     cadence: Option<Cadence>,
     points: Configuration,
+    units: Units,
+    model_fraction: f64,
+}
+
+impl Default for FrameKnobs {
+    fn default() -> Self {
+        FrameKnobs {
+            off: false,
+            cadence: None,
+            points: Configuration::Current,
+            units: Units::default(),
+            model_fraction: 1.0,
+        }
+    }
 }
 
 impl FrameKnobs {
-    fn options(&self, end_time: f64) -> FrameOptions {
-        FrameOptions {
+    fn options(&self, end_time: f64) -> OutputOptions {
+        OutputOptions {
             points: self.points,
             cadence: self
                 .cadence
                 .unwrap_or_else(|| Cadence::default_for(end_time)),
+            units: self.units.clone(),
+            model_fraction: self.model_fraction,
         }
     }
+}
+
+/// `units: #{ length: "mm", force: "N", time: "mm" }` (each key optional).
+fn units(v: &Dynamic, into: &mut Units) -> ScriptResult<()> {
+    let Some(map) = v.clone().try_cast::<Map>() else {
+        return runtime_error(format!(
+            "units must be a map #{{ length: \"mm\", force: \"N\", time: \"s\" }}, got {}",
+            v.type_name()
+        ));
+    };
+    for (key, value) in &map {
+        let Ok(name) = value.clone().into_string() else {
+            return runtime_error(format!("units.{key} must be a string"));
+        };
+        if name.contains([',', '"', '[', ']', '\n', '\r']) {
+            return runtime_error(format!(
+                "units.{key} = '{name}' must not contain , \" [ ] or line breaks (it names CSV columns)"
+            ));
+        }
+        match key.as_str() {
+            "length" => into.length = name,
+            "force" => into.force = name,
+            "time" => into.time = name,
+            other => {
+                return runtime_error(format!(
+                    "unknown unit '{other}' (known: length, force, time)"
+                ))
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Output knobs of the script layer.
@@ -643,6 +697,8 @@ pub const SETTING_KEYS: &[&str] = &[
     "output_every",
     "output_interval",
     "frame_points",
+    "units",
+    "model_fraction",
     "checkpoint_every",
     "curvature",
     "frame",
@@ -738,6 +794,18 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             "output_interval" => {
                 st.frames.off = false;
                 st.frames.cadence = Some(lift(Cadence::interval(num("output_interval")?))?);
+            }
+            "units" => units(v, &mut st.frames.units)?,
+            "model_fraction" => {
+                let f = num("model_fraction")?;
+                if !(f > 0.0 && f <= 1.0) {
+                    return fail(Error::input(
+                        "model_fraction",
+                        f,
+                        "must be in (0, 1] (1/4 for a quarter model)",
+                    ));
+                }
+                st.frames.model_fraction = f;
             }
             "frame_points" => {
                 let name = v.clone().into_string().unwrap_or_default();
@@ -932,7 +1000,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         |s: &mut ScriptSim, spec: Map| -> ScriptResult<()> {
             let mut st = s.borrow_mut();
             let mut knobs = Knobs {
-                frames: st.frames,
+                frames: st.frames.clone(),
                 checkpoint_every: st.checkpoint_every,
                 max_increments: st.host.limits.max_increments,
             };

@@ -7,6 +7,7 @@
 mod api_cad;
 mod api_charts;
 mod api_mesh_map;
+mod api_numbers;
 mod api_scene;
 mod api_sim;
 mod api_tools;
@@ -112,6 +113,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);
     api_mesh_map::register(&mut engine);
+    api_numbers::register(&mut engine);
     register_checks(&mut engine);
     engine
 }
