@@ -5,6 +5,7 @@
 //! and size limits, and output only below the run's output folder.
 
 mod api_charts;
+mod api_mesh_import;
 mod api_scene;
 mod api_sim;
 mod api_tools;
@@ -105,6 +106,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.on_progress(move |ops| limits::progress_check(&limits, &clock, ops).map(Dynamic::from));
     let host = Rc::new(host);
     api_scene::register(&mut engine, host.clone());
+    api_mesh_import::register(&mut engine, policy.clone(), host.limits.clone());
     api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);
