@@ -281,9 +281,18 @@ impl ReadPolicy {
         Ok(canonical)
     }
 
-    /// Reads the text of a file [`resolve`](Self::resolve) accepts: opened non-blocking and
-    /// without following links, at most `max_bytes` read, UTF-8 required.
+    /// Reads the text of a file [`resolve`](Self::resolve) accepts (see
+    /// [`read_bytes`](Self::read_bytes)); UTF-8 required.
     pub fn read_to_string(&self, given: &str, what: &str) -> Result<(PathBuf, String)> {
+        let (path, bytes) = self.read_bytes(given, what)?;
+        let text = String::from_utf8(bytes)
+            .map_err(|_| Error::Input(format!("{what} \"{given}\" is not UTF-8 text")))?;
+        Ok((path, text))
+    }
+
+    /// Reads the bytes of a file [`resolve`](Self::resolve) accepts: opened non-blocking and
+    /// without following links, at most `max_bytes` read.
+    pub fn read_bytes(&self, given: &str, what: &str) -> Result<(PathBuf, Vec<u8>)> {
         use std::os::unix::fs::OpenOptionsExt;
         let path = self.resolve(given, what)?;
         let file = std::fs::OpenOptions::new()
@@ -310,9 +319,7 @@ impl ReadPolicy {
                 self.max_bytes
             )));
         }
-        let text = String::from_utf8(bytes)
-            .map_err(|_| Error::Input(format!("{what} \"{given}\" is not UTF-8 text")))?;
-        Ok((path, text))
+        Ok((path, bytes))
     }
 }
 

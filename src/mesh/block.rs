@@ -164,6 +164,7 @@ impl Mesh {
             hexes,
             node_sets,
             columns,
+            ..Mesh::default()
         })
     }
 }

@@ -34,6 +34,10 @@ use crate::{Error, Result};
 mod block;
 mod faces;
 mod map;
+pub mod gmsh;
+mod import;
+pub mod inp;
+mod sets;
 
 pub use block::{End, Grading, MAX_BLOCK_NODES};
 pub use faces::{quad_area, HEX_FACES};
@@ -80,6 +84,8 @@ pub struct Mesh {
     node_sets: BTreeMap<String, Vec<usize>>,
     /// Through-thickness node columns of a sheet (see [`Mesh::columns`]).
     columns: Vec<Vec<usize>>,
+    /// Named element sets and face sets of imported meshes (see `sets.rs`).
+    sets: sets::Sets,
 }
 
 impl Mesh {
@@ -89,8 +95,7 @@ impl Mesh {
         let mesh = Mesh {
             nodes,
             hexes,
-            node_sets: BTreeMap::new(),
-            columns: Vec::new(),
+            ..Mesh::default()
         };
         mesh.validate()?;
         Ok(mesh)

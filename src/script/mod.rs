@@ -8,6 +8,7 @@ mod api_cad;
 mod api_charts;
 mod api_mesh_map;
 mod api_numbers;
+mod api_mesh_import;
 mod api_scene;
 mod api_sim;
 mod api_tools;
@@ -109,6 +110,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     let host = Rc::new(host);
     api_scene::register(&mut engine, host.clone());
     api_cad::register(&mut engine, policy.clone());
+    api_mesh_import::register(&mut engine, policy.clone(), host.limits.clone());
     api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);

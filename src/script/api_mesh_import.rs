@@ -1,0 +1,101 @@
+//! Meshes from files and structured meshes beyond `block()`, for scripts: Gmsh MSH 4.1,
+//! CalculiX/Abaqus decks (every read through the run's read policy), and the names of a
+//! mesh's sets. Registered in one place.
+
+use super::convert::*;
+use crate::mesh::gmsh::read_gmsh;
+use crate::mesh::inp::read_inp;
+use crate::mesh::Mesh;
+use crate::paths::ReadPolicy;
+use rhai::{Array, Dynamic, Engine};
+use std::path::Path;
+use std::rc::Rc;
+
+pub fn register(engine: &mut Engine, policy: Rc<ReadPolicy>, limits: super::limits::Limits) {
+    register_files(engine, policy, limits);
+    register_set_names(engine);
+}
+
+/// The path a script gave, relative to the script's folder when it is relative.
+fn shown(policy: &ReadPolicy, path: &Path) -> String {
+    path.strip_prefix(policy.base())
+        .unwrap_or(path)
+        .display()
+        .to_string()
+}
+
+fn checked(mesh: Mesh, limits: &super::limits::Limits) -> ScriptResult<Mesh> {
+    limits
+        .check_mesh(mesh.node_count() as u64)
+        .or_else(runtime_error)?;
+    Ok(mesh)
+}
+
+fn register_files(engine: &mut Engine, policy: Rc<ReadPolicy>, limits: super::limits::Limits) {
+    // mesh_from_gmsh(path): a Gmsh MSH 4.1 file (ASCII or binary), physical groups as sets.
+    let (p, l) = (policy.clone(), limits.clone());
+    engine.register_fn("mesh_from_gmsh", move |path: &str| -> ScriptResult<Mesh> {
+        let (_, bytes) = lift(p.read_bytes(path, "Gmsh mesh"))?;
+        checked(lift(read_gmsh(&bytes, path))?, &l)
+    });
+    // mesh_from_inp(path): the mesh of a CalculiX/Abaqus deck; *INCLUDE files are read
+    // relative to the including file, through the same policy.
+    engine.register_fn("mesh_from_inp", move |path: &str| -> ScriptResult<Mesh> {
+        let (_, text) = lift(policy.read_to_string(path, "CalculiX/Abaqus deck"))?;
+        let base = policy.base().to_path_buf();
+        let mut include = |given: &str, from: &str| {
+            let from_dir = base.join(from);
+            let dir = from_dir.parent().unwrap_or(&base);
+            let wanted = dir.join(given);
+            let (resolved, text) =
+                policy.read_to_string(&wanted.display().to_string(), "included file")?;
+            Ok((shown(&policy, &resolved), text))
+        };
+        checked(lift(read_inp(&text, path, &mut include))?, &limits)
+    });
+}
+
+fn names<'a>(it: impl Iterator<Item = &'a str>) -> Array {
+    it.map(|s| Dynamic::from(s.to_string())).collect()
+}
+
+fn register_set_names(engine: &mut Engine) {
+    engine.register_get("node_sets", |m: &mut Mesh| names(m.node_set_names()));
+    engine.register_get("element_sets", |m: &mut Mesh| names(m.element_set_names()));
+    engine.register_get("face_sets", |m: &mut Mesh| names(m.face_set_names()));
+    engine.register_fn(
+        "element_set",
+        |m: &mut Mesh, name: &str| -> ScriptResult<Array> {
+            Ok(lift(m.element_set(name))?
+                .iter()
+                .map(|&e| Dynamic::from(e as i64))
+                .collect())
+        },
+    );
+    // face_set(name): each face as its 4 node indices, counter-clockwise seen from outside.
+    engine.register_fn(
+        "face_set",
+        |m: &mut Mesh, name: &str| -> ScriptResult<Array> {
+            Ok(lift(m.face_set(name))?
+                .iter()
+                .map(|q| {
+                    Dynamic::from(
+                        q.iter()
+                            .map(|&n| Dynamic::from(n as i64))
+                            .collect::<Array>(),
+                    )
+                })
+                .collect())
+        },
+    );
+    // Element connectivity, for comparing meshes: mesh.element(e) -> 8 node indices.
+    engine.register_fn("element", |m: &mut Mesh, e: i64| -> ScriptResult<Array> {
+        match m.hexes.get(e as usize) {
+            Some(h) if e >= 0 => Ok(h.iter().map(|&n| Dynamic::from(n as i64)).collect()),
+            _ => runtime_error(format!(
+                "element {e} is out of range (mesh has {} elements)",
+                m.hexes.len()
+            )),
+        }
+    });
+}
