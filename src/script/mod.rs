@@ -6,9 +6,9 @@
 
 mod api_cad;
 mod api_charts;
+mod api_mesh_import;
 mod api_mesh_map;
 mod api_numbers;
-mod api_mesh_import;
 mod api_scene;
 mod api_sim;
 mod api_tools;
