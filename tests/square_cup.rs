@@ -113,15 +113,12 @@ fn run_cup_with(out: &Path, sets: &[&str]) -> Value {
 /// Issue 14 on the coarse cup (paper variant, 8 x 8 x 1, 15 mm in 0.5 mm increments), with
 /// the engine's default r, predictor and anti-cycling (the script sets none of them):
 /// - median Newton iterations per increment <= 6, none above 25, at most 2 cutbacks, and
-///   at least 90 % full Newton steps (lower bound: one backtrack shortens one step;
-///   measured 0.94, and 0.85 before the contraction test also judged full steps that
-///   change contact statuses);
+///   at least 80 % full Newton steps (lower bound: one backtrack shortens one step);
 /// - Newton stays Newton: the observed order of the last three force residuals above
 ///   round-off (1e-10 relative) is >= 1.8 in every increment from the 7th on. Measured
 ///   today: the first six increments (the first contact of the flat blank and the holder
-///   coming on) end with orders 2.08, 1.91, 1.92, 1.55, 1.94, 1.79 (the first was -18.8
-///   before the contraction test judged status-changing steps), because a status still
-///   changes in the last iterations of the 4th and 6th; that is recorded here, not hidden;
+///   coming on) end with orders -18.8, 1.91, 1.92, 1.55, 1.94, 1.79, because a status
+///   still changes in their last iterations; that is recorded here, not hidden;
 /// - the converged answer does not depend on r (the augmented Lagrangian's solution does
 ///   not): the script's former hand-picked r = E t on every node gives the same draw-in
 ///   and punch force peak within 1e-6 relative (the Newton tolerance is 1e-9).
@@ -136,7 +133,7 @@ fn defaults_converge_in_few_iterations_and_keep_the_answer() {
     assert!(number(newton, "median_iterations") <= 6.0, "{newton}");
     assert!(number(newton, "max_iterations") <= 25.0, "{newton}");
     assert!(number(&summary, "cutbacks") <= 2.0, "{summary}");
-    assert!(number(newton, "full_step_fraction_min") >= 0.9, "{newton}");
+    assert!(number(newton, "full_step_fraction_min") >= 0.8, "{newton}");
     let orders: Vec<f64> = newton["last_orders"]
         .as_array()
         .expect("orders")

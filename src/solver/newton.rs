@@ -61,12 +61,13 @@ impl Simulation {
         }
     }
 
-    /// The contraction test for a full Newton step `dx` that raised the merit `|R|`, to the
-    /// state evaluated as `trial`: the step is good if the next Newton correction
-    /// `dx' = -J(x + dx)⁻¹ R(x + dx)` is shorter, `Θ = |dx'| / |dx| <= 3/4` (displacement
-    /// parts; Θ is the contraction factor of Newton's convergence theory, Deuflhard,
-    /// *Newton Methods for Nonlinear Problems*, 2004, sec. 2.1). Returns `dx'` if so, for
-    /// the next iteration.
+    /// The contraction test for a full Newton step `dx` that raised the merit `|R|`, from
+    /// the state evaluated as `at_x` to the one evaluated as `trial`: the step is good if
+    /// it changed no contact status (a smooth step; otherwise the merit decides) and the
+    /// next Newton correction `dx' = -J(x + dx)⁻¹ R(x + dx)` is shorter,
+    /// `Θ = |dx'| / |dx| <= 3/4` (displacement parts; Θ is the contraction factor of
+    /// Newton's convergence theory, Deuflhard, *Newton Methods for Nonlinear Problems*,
+    /// 2004, sec. 2.1). Returns `dx'` if so, for the next iteration.
     ///
     /// Why: the merit `|R|` weighs each mode by its stiffness. On a thin body the
     /// membrane stiffness exceeds the bending stiffness by `(L/t)²`, so the membrane
@@ -77,24 +78,22 @@ impl Simulation {
     /// in 3 iterations. Corrections measure the error in displacements, free of that
     /// scaling. The simplified correction `J(x)⁻¹ R(x + dx)` would be cheaper but misses
     /// the tension stiffening that the first step brings in (`Θ = 53` on a fine mesh that
-    /// then converges quadratically). Cost: none when accepted (`dx'` is the next step),
-    /// one solve when refused.
-    ///
-    /// Steps that change contact statuses are judged the same way. Near the solution of a
-    /// contact increment the Newton model of `|R|` holds only up to the nearest status
-    /// boundary, which with hundreds of barely touching nodes lies a few hundredths of the
-    /// step away: on the 25 x 25 x 1 cup the merit falls along `dx` with slope `-|R|`
-    /// (Newton's) up to `alpha = 1e-2` and rises at `alpha = 1/16`, so the backtracking
-    /// crawled at its smallest step for a dozen iterations. A full step across those
-    /// boundaries whose next correction contracts is the active-set update of a
-    /// primal-dual active-set method, and it is taken: the first increment of that cup
-    /// went from 58 to 45 iterations (docs/convergence.md).
+    /// then converges quadratically). Cost: none when accepted (`dx'` is the next step).
     fn newton_contraction(
         &self,
+        at_x: &Evaluation,
         trial: &Evaluation,
         dx: &[f64],
         linear: &mut dyn LinearSolver,
     ) -> Result<Option<Vec<f64>>> {
+        let smooth = at_x.nodal.iter().zip(&trial.nodal).all(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .all(|((na, _), (nb, _))| na.status == nb.status)
+        });
+        if !smooth {
+            return Ok(None);
+        }
         let n_u = 3 * self.dofs.n_nodes;
         let next = self.newton_step(trial, linear)?;
         Ok((norm(&next[..n_u]) <= 0.75 * norm(&dx[..n_u])).then_some(next))
@@ -371,7 +370,7 @@ impl Simulation {
                 &weights,
                 &mut |trial| {
                     let ts = Instant::now();
-                    contracted = self.newton_contraction(trial, &dx, linear)?;
+                    contracted = self.newton_contraction(&eval, trial, &dx, linear)?;
                     contraction_time += ts.elapsed().as_secs_f64();
                     Ok(contracted.is_some())
                 },
