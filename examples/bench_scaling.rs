@@ -114,10 +114,11 @@ fn main() {
         std::process::exit(2)
     });
     println!(
-        "{:>9} {:>9} {:>10} {:>11} {:>9} {:>11} {:>9} {:>9} {:>10} {:>9} {:>8}",
-        "mesh", "n", "nnz(A)", "L+U", "new ms", "floor L", "floor ms", "new/floor", "backward", "run MiB", "bench MiB"
+        "{:>9} {:>7} {:>8} {:>9} {:>8} {:>9} {:>8} {:>8} {:>9} {:>8} {:>7} {:>7}",
+        "mesh", "n", "nnz(A)", "L+U", "fact ms", "+solve ms", "floor L", "floor ms", "fact/floor", "backward", "run MiB", "bench MiB"
     );
     let mut points = Vec::new();
+    let mut ratios = Vec::new();
     for &(cells, layers) in &o.sizes {
         let dump = o.dumps.join(format!("tribo_scaling_{cells}x{layers}.sys"));
         let run_peak = if o.fresh || !dump.exists() {
@@ -141,11 +142,12 @@ fn main() {
             }
         };
         println!(
-            "{:>9} {:>9} {:>10} {:>11} {:>9.1} {:>11} {:>9.1} {:>9.2} {:>10.1e} {:>9} {:>8.0}",
+            "{:>9} {:>7} {:>8} {:>9} {:>8.1} {:>9.1} {:>8} {:>8.1} {:>9.2} {:>8.1e} {:>7} {:>7.0}",
             format!("{cells}x{cells}x{layers}"),
             row.n,
             row.nnz,
             row.factor_entries,
+            row.factor_cpu_ms,
             row.new_cpu_ms,
             row.floor_entries,
             row.floor_cpu_ms,
@@ -158,13 +160,26 @@ fn main() {
             println!("  ({} pivoting fallbacks)", row.fallbacks);
         }
         points.push((row.n as f64, row.new_cpu_ms, row.floor_cpu_ms));
+        ratios.push(row.ratio());
     }
     let fit = |pick: fn(&(f64, f64, f64)) -> f64| {
         floor::growth_exponent(&points.iter().map(|p| (p.0, pick(p))).collect::<Vec<_>>())
     };
+    for pair in points.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let local = |ta: f64, tb: f64| (tb / ta).ln() / (b.0 / a.0).ln();
+        println!(
+            "n {:.0} -> {:.0}: factorization + solve p = {:.2}, floor p = {:.2}",
+            a.0,
+            b.0,
+            local(a.1, b.1),
+            local(a.2, b.2)
+        );
+    }
     println!(
-        "CPU milliseconds per numeric factorization + solve (one thread, mean of {} after one untimed call); fitted growth t ~ n^p: new p = {:.2}, floor p = {:.2}",
+        "CPU milliseconds (one thread, mean of at least {} calls and 1 s after one untimed call); fact/floor {:?}; fitted growth t ~ n^p over all sizes: factorization + solve p = {:.2}, floor p = {:.2}",
         o.repeats,
+        ratios.iter().map(|r| (r * 100.0).round() / 100.0).collect::<Vec<_>>(),
         fit(|p| p.1),
         fit(|p| p.2)
     );

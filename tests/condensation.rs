@@ -134,8 +134,15 @@ fn symmetric_lu_steps_equal_the_pivoting_lu_steps() {
 /// Newton's tolerance.
 #[test]
 fn symmetric_lu_and_pivoting_lu_runs_agree() {
-    let mut a = drag_with(false, LinearSolverKind::SymmetricLu);
-    let mut b = drag_with(false, LinearSolverKind::Lu);
+    runs_agree(
+        drag_with(false, LinearSolverKind::SymmetricLu),
+        drag_with(false, LinearSolverKind::Lu),
+    );
+}
+
+/// Runs both simulations to the end: the same iterations in every increment, the same
+/// converged unknowns to 1e-9 of the largest (Newton's tolerance).
+fn runs_agree(mut a: Simulation, mut b: Simulation) {
     a.run(|_, _| Ok(())).unwrap();
     b.run(|_, _| Ok(())).unwrap();
     let scale = b.unknowns().iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -145,7 +152,7 @@ fn symmetric_lu_and_pivoting_lu_runs_agree() {
         .zip(b.unknowns())
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     let iters = |s: &Simulation| s.history.iter().map(|r| r.iterations).collect::<Vec<_>>();
-    println!("max difference {d:.2e} of {scale:.2e}");
+    println!("max difference {d:.2e} of {scale:.2e}; iterations {:?}", iters(&a));
     assert_eq!(iters(&a), iters(&b));
     assert!(d < 1e-9 * scale, "runs differ by {d}");
 }
@@ -216,20 +223,7 @@ fn two_pair_nodes_condense_to_the_mixed_step() {
 /// Newton's tolerance, with and without the elimination.
 #[test]
 fn two_pair_condensed_and_mixed_runs_agree() {
-    let mut a = two_roller_drag(true);
-    let mut b = two_roller_drag(false);
-    a.run(|_, _| Ok(())).unwrap();
-    b.run(|_, _| Ok(())).unwrap();
-    let scale = b.unknowns().iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let d = a
-        .unknowns()
-        .iter()
-        .zip(b.unknowns())
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-    let iters = |s: &Simulation| s.history.iter().map(|r| r.iterations).collect::<Vec<_>>();
-    println!("max difference {d:.2e} of {scale:.2e}; iterations {:?}", iters(&a));
-    assert_eq!(iters(&a), iters(&b));
-    assert!(d < 1e-9 * scale, "runs differ by {d}");
+    runs_agree(two_roller_drag(true), two_roller_drag(false));
 }
 
 /// A node with both pairs active (here: both sliding without friction, normals z and x)
