@@ -69,7 +69,7 @@
 //! # Integration and cost
 //!
 //! 2 x 2 Gauss points in plane (full: no hourglass modes) times `n` points through the
-//! thickness (default 5; [`thickness_rule`]: Simpson for odd `n`, Gauss otherwise): point `k * 4 + q` is in-plane point `q` (in the
+//! thickness (default 5; [`thickness_rule`]: Newton-Cotes for odd `n`, Gauss otherwise): point `k * 4 + q` is in-plane point `q` (in the
 //! order of the corners 0-3) at thickness level `k` (bottom to top). Per point and local
 //! iteration: one material update (plus one 3 x 3 eigen-decomposition under finite
 //! strain); per point once: `Bᵀ ℂ B`, ~4.3k multiplications.
@@ -231,33 +231,45 @@ pub fn check_columns(mesh: &Mesh) -> Result<()> {
     Ok(())
 }
 
-/// The through-thickness rule of `n` points on `[-1, 1]`, ascending: composite Simpson
-/// for odd `n >= 3` (equally spaced, the faces and the mid-surface among the points),
-/// Gauss-Legendre otherwise. Why Simpson: in plastic bending the stress changes sign at
-/// the mid-surface, so the moment integrand `σ z` has a kink there; Simpson's rule has a
-/// point on the kink and integrates each half exactly up to cubics, while 5 Gauss points
-/// across it miss the fully plastic moment `∫|z| dz` by 5.5 %. Both are exact for the
-/// elastic bending stiffness (`∫z² dz`, and `∫z³` for tapered elements).
+/// The through-thickness rule of `n` points on `[-1, 1]`, ascending: for odd `n >= 5`
+/// equally spaced points (the faces and the mid-surface among them) with a Newton-Cotes
+/// rule on each half (composite Simpson, closed by the 3/8 rule when a half has an odd
+/// number of intervals), Simpson for `n = 3`, Gauss-Legendre otherwise. Why: in plastic
+/// bending the stress changes sign at the mid-surface, so the moment integrand `σ z` has a
+/// kink there; a rule with the kink as a panel boundary integrates each half exactly up to
+/// cubics, while 5 Gauss points across it miss the fully plastic moment `∫|z| dz` by 5.5 %.
+/// All are exact for the elastic bending stiffness (`∫z² dz`, and `∫z³` for tapered
+/// elements).
 pub fn thickness_rule(n: usize) -> (Vec<f64>, Vec<f64>) {
-    if n >= 3 && n % 2 == 1 {
-        let h = 2.0 / (n - 1) as f64;
-        let x = (0..n).map(|i| -1.0 + i as f64 * h).collect();
-        let w = (0..n)
-            .map(|i| {
-                let m = if i == 0 || i == n - 1 {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
-                m * h / 3.0
-            })
-            .collect();
-        (x, w)
-    } else {
-        gauss_legendre(n)
+    if n == 3 {
+        return (vec![-1.0, 0.0, 1.0], vec![1.0 / 3.0, 4.0 / 3.0, 1.0 / 3.0]);
     }
+    if n < 5 || n % 2 == 0 {
+        return gauss_legendre(n);
+    }
+    // Each half has m intervals of width h: composite Simpson, closed by the 3/8 rule on
+    // the last three intervals when m is odd; both exact for cubics.
+    let m = (n - 1) / 2;
+    let h = 1.0 / m as f64;
+    let mut half = vec![0.0; m + 1];
+    let simpson = if m % 2 == 0 { m } else { m - 3 };
+    for i in (0..simpson).step_by(2) {
+        half[i] += h / 3.0;
+        half[i + 1] += 4.0 * h / 3.0;
+        half[i + 2] += h / 3.0;
+    }
+    if simpson < m {
+        for (k, c) in [1.0, 3.0, 3.0, 1.0].iter().enumerate() {
+            half[simpson + k] += 3.0 * h / 8.0 * c;
+        }
+    }
+    let x = (0..n).map(|i| -1.0 + i as f64 * h).collect();
+    let mut w = vec![0.0; n];
+    for (i, wi) in half.iter().enumerate() {
+        w[m + i] += wi;
+        w[m - i] += wi;
+    }
+    (x, w)
 }
 
 /// Gauss-Legendre points and weights on `[-1, 1]`, ascending (Newton on the Legendre
@@ -267,39 +279,37 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut w = Vec::with_capacity(n);
     for i in 0..n {
         let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
         for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let kf = k as f64;
-                let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
+            let (p, dp) = legendre(n, z);
+            let dz = p / dp;
             z -= dz;
             if dz.abs() < 1e-16 {
                 break;
             }
         }
-        // Final derivative at the converged root.
-        let (mut p0, mut p1) = (1.0, z);
-        for k in 2..=n {
-            let kf = k as f64;
-            let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-            p0 = p1;
-            p1 = p2;
-        }
-        if n > 1 {
-            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-        }
+        let (_, dp) = legendre(n, z);
         x.push(z);
         w.push(2.0 / ((1.0 - z * z) * dp * dp));
     }
     x.reverse();
     w.reverse();
     (x, w)
+}
+
+/// The Legendre polynomial `P_n(z)` and its derivative (three-term recurrence).
+fn legendre(n: usize, z: f64) -> (f64, f64) {
+    let (mut p0, mut p1) = (1.0, z);
+    for k in 2..=n {
+        let kf = k as f64;
+        let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
+        p0 = p1;
+        p1 = p2;
+    }
+    if n == 1 {
+        (z, 1.0)
+    } else {
+        (p1, n as f64 * (z * p1 - p0) / (z * z - 1.0))
+    }
 }
 
 /// In-plane natural coordinates of point `q` (corner order 0-3).
@@ -819,5 +829,39 @@ impl Element<DOFS> for SolidShell {
                 material.elastic_energy_density(s)
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rules integrate what they must: Gauss-Legendre exactly up to degree 2n - 1, the
+    /// odd Newton-Cotes rules (n >= 5) cubics in `|z|` on each half exactly (`|z|`, the
+    /// fully plastic moment, is the point of using them), all `z²`, weights sum to 2.
+    #[test]
+    fn thickness_rules() {
+        for n in 1..=MAX_THICKNESS_POINTS {
+            let (x, w) = gauss_legendre(n);
+            for d in 0..2 * n {
+                let exact = if d % 2 == 0 { 2.0 / (d as f64 + 1.0) } else { 0.0 };
+                let sum: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(d as i32)).sum();
+                assert!((sum - exact).abs() < 1e-13, "Gauss {n}, degree {d}: {sum}");
+            }
+            assert!(x.windows(2).all(|p| p[0] < p[1]));
+            let (x, w) = thickness_rule(n);
+            let sum = |f: &dyn Fn(f64) -> f64| -> f64 { x.iter().zip(&w).map(|(x, w)| w * f(*x)).sum() };
+            assert!((sum(&|_| 1.0) - 2.0).abs() < 1e-14);
+            if n >= 2 {
+                assert!((sum(&|z| z * z) - 2.0 / 3.0).abs() < 1e-14, "{n}");
+            }
+            if n >= 5 && n % 2 == 1 {
+                assert!((sum(&|z| z.abs()) - 1.0).abs() < 1e-14, "{n}");
+                let cubic = |z: f64| z.abs().powi(3) - 2.0 * z * z + z.abs();
+                assert!((sum(&cubic) - (0.5 - 4.0 / 3.0 + 1.0)).abs() < 1e-13, "{n}");
+                assert_eq!((x[0], x[n / 2], x[n - 1]), (-1.0, 0.0, 1.0));
+            }
+        }
+        assert!(check_thickness_points(0).is_err() && check_thickness_points(13).is_err());
     }
 }
