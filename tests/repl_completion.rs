@@ -10,26 +10,13 @@ use common::pty::Session;
 
 const BIN: &str = env!("CARGO_BIN_EXE_tribo");
 
-const SCENE: &str = r#"
-let mesh = block([0, 0, 0], [16, 1, 2], [16, 1, 2]);
-let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
-let roller = tool("roller", cylinder([4.0, 0, 7.02], [0, 1, 0], 5.0))
-    .path([[0, 0, 0, 0], [1, 0, 0, -0.12], [3, 8.0, 0, -0.12]]).friction(coulomb(0.2));
-sim.add_tool(roller, "z+");
-sim.fix("z-", "xyz");
-sim.fix("y-", "y");
-sim.fix("y+", "y");
-sim.settings(#{ end_time: 3.0, increments: 30, output_every: 0 });
-sim.run();
-"#;
-
 #[test]
 fn completion_multi_line_input_and_help_in_a_terminal() {
     let dir = std::env::temp_dir().join(format!("tribo-repl-completion-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let script = dir.join("drag.rhai");
-    std::fs::write(&script, SCENE).unwrap();
+    std::fs::write(&script, common::pty::drag_scene(16, 30, 0, "sim.run();")).unwrap();
     let mut s = Session::start(BIN, &script, &dir.join("out"), "xterm");
     let at = s.expect(0, "tribo> ");
 

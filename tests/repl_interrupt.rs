@@ -13,19 +13,14 @@ use std::time::{Duration, Instant};
 const BIN: &str = env!("CARGO_BIN_EXE_tribo");
 
 /// A cylinder dragged over a block in 300 increments (about 3 s of CPU), stepping itself.
-const SCENE: &str = r#"
-let mesh = block([0, 0, 0], [16, 1, 2], [32, 1, 4]);
-let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
-let roller = tool("roller", cylinder([4.0, 0, 7.02], [0, 1, 0], 5.0))
-    .path([[0, 0, 0, 0], [1, 0, 0, -0.12], [3, 8.0, 0, -0.12]]).friction(coulomb(0.2));
-sim.add_tool(roller, "z+");
-sim.fix("z-", "xyz");
-sim.fix("y-", "y");
-sim.fix("y+", "y");
-sim.settings(#{ end_time: 3.0, increments: 300, output_every: 1000 });
-while !sim.finished() { sim.step(); }
-print("the loop ran while loading");
-"#;
+fn scene() -> String {
+    common::pty::drag_scene(
+        32,
+        300,
+        1000,
+        "while !sim.finished() { sim.step(); }\nprint(\"the loop ran while loading\");",
+    )
+}
 
 fn history_rows(out: &Path) -> usize {
     std::fs::read_to_string(out.join("history.csv"))
@@ -40,7 +35,7 @@ fn ctrl_c_during_run_returns_to_the_prompt_and_stepping_goes_on() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let script = dir.join("drag.rhai");
-    std::fs::write(&script, SCENE).unwrap();
+    std::fs::write(&script, scene()).unwrap();
     let out = dir.join("out");
     let mut s = Session::start(BIN, &script, &out, "dumb");
 

@@ -8,6 +8,27 @@ use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+/// A cylinder dragged over a 16 x 1 x 2 block of `cells` x 1 x `cells / 8` hexahedra in
+/// `increments` fixed increments up to the end time 3, writing a frame every `output_every`
+/// (0: no files), then `tail` (how the scene is stepped). Line 11 is the first of `tail`.
+pub fn drag_scene(cells: usize, increments: usize, output_every: usize, tail: &str) -> String {
+    format!(
+        r#"
+let mesh = block([0, 0, 0], [16, 1, 2], [{cells}, 1, {depth}]);
+let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
+let roller = tool("roller", cylinder([4.0, 0, 7.02], [0, 1, 0], 5.0))
+    .path([[0, 0, 0, 0], [1, 0, 0, -0.12], [3, 8.0, 0, -0.12]]).friction(coulomb(0.2));
+sim.add_tool(roller, "z+");
+sim.fix("z-", "xyz");
+sim.fix("y-", "y");
+sim.fix("y+", "y");
+sim.settings(#{{ end_time: 3.0, increments: {increments}, output_every: {output_every} }});
+{tail}
+"#,
+        depth = cells / 8
+    )
+}
+
 pub struct Session {
     pub child: Child,
     input: ChildStdin,

@@ -8,7 +8,13 @@
 //! Ctrl-C while a line runs (`sim.run()`, `sim.step()`) abandons the increment under way
 //! and returns to the prompt; the simulation keeps the state of its last converged
 //! increment and the next `sim.step()` goes on from there. At the prompt, Ctrl-C clears
-//! the line (rustyline's behaviour) and Ctrl-D leaves.
+//! the line (and an open statement) and Ctrl-D leaves.
+//!
+//! A line that leaves a statement open (Rhai reaches the end of the text still expecting
+//! more) is kept and the next line is appended to it, under the prompt `  ...> `; this is
+//! done here rather than in rustyline's validator so that it works the same when the input
+//! is not a terminal. TAB completion ([`complete`]) and `:help NAME` ([`help`]) take their
+//! names from the engine's registrations ([`catalogue`]); values are shown by [`display`].
 
 mod catalogue;
 mod complete;
