@@ -315,3 +315,39 @@ fn history_names_units_and_the_model_fraction() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+/// A field map restricted to a tool shows values only where that tool touched the face
+/// set (the rest grey, NaN in its CSV), and `range: "law"` spans the law's coefficients.
+#[test]
+fn field_maps_split_by_tool_on_the_law_range() {
+    let charts = r#"sim.run();
+        sim.settings(#{ units: #{ length: "mm" } });
+        sim.chart_field("mu_punch.svg", "z+", "mu", #{ tool: "punch", range: "law" });
+        sim.chart_field("mu_floor.svg", "z+", "mu", #{ tool: "floor" });"#;
+    let out = run("maps", &scene("increments: 2", charts));
+    let values = |name: &str| -> Vec<f64> {
+        let csv = std::fs::read_to_string(out.join(name)).unwrap();
+        csv.lines()
+            .skip(1)
+            .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+            .collect()
+    };
+    let punch = values("mu_punch.csv");
+    assert_eq!(punch.len(), 25, "the 5 x 5 nodes of the top face");
+    let touched = punch.iter().filter(|v| v.is_finite()).count();
+    assert!(touched > 0, "{punch:?}");
+    assert!(punch.iter().filter(|v| v.is_finite()).all(|&v| v == 0.1));
+    // The floor never touches the top face: every value is missing.
+    assert!(values("mu_floor.csv").iter().all(|v| v.is_nan()));
+    // Coulomb 0.1: the law's range is 0.1 +- 10 %, ticked at both ends; axes in mm.
+    let svg = std::fs::read_to_string(out.join("mu_punch.svg")).unwrap();
+    let ticks: Vec<f64> = svg
+        .split("class=\"tick\">")
+        .skip(1)
+        .map(|t| t[..t.find('<').unwrap()].parse().unwrap())
+        .collect();
+    assert!((ticks[0] - 0.09).abs() < 1e-12, "{ticks:?}");
+    assert!((ticks[ticks.len() - 1] - 0.11).abs() < 1e-12, "{ticks:?}");
+    assert!(svg.contains(">x [mm]</text>") && svg.contains(">y [mm]</text>"));
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+}

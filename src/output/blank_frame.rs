@@ -69,7 +69,7 @@ struct NodalContact {
     flips: Vec<f64>,
 }
 
-fn nodal_contact(sim: &Simulation) -> NodalContact {
+fn nodal_contact(sim: &Simulation, only: Option<usize>) -> NodalContact {
     let n = sim.model.mesh.nodes.len();
     let mut out = NodalContact {
         status: vec![0.0; n],
@@ -86,6 +86,9 @@ fn nodal_contact(sim: &Simulation) -> NodalContact {
         flips: vec![0.0; n],
     };
     for (c, contact) in sim.model.contacts.iter().enumerate() {
+        if only.is_some_and(|o| o != c) {
+            continue;
+        }
         for (k, s) in sim.contact_states(c).iter().enumerate() {
             let node = contact.candidates[k];
             let ln = s.lambda_n();
@@ -127,10 +130,16 @@ fn nodal_contact(sim: &Simulation) -> NodalContact {
 /// element-averaged Cauchy stress (components named xx, yy, zz, xy, yz, xz), von Mises
 /// stress and equivalent plastic strain on the cells.
 pub fn frame(sim: &Simulation, configuration: Configuration) -> Frame {
+    frame_against(sim, configuration, None)
+}
+
+/// As [`frame`], with the contact fields of tool `only` alone when given (a chart of the
+/// punch side shows the punch's work, not the holder's).
+pub fn frame_against(sim: &Simulation, configuration: Configuration, only: Option<usize>) -> Frame {
     let mesh = &sim.model.mesh;
     let n = mesh.nodes.len();
     let u = sim.displacements();
-    let contact = nodal_contact(sim);
+    let contact = nodal_contact(sim, only);
     let per = sim.points().len() / mesh.hexes.len().max(1);
     let mut stress = vec![0.0; 6 * mesh.hexes.len()];
     let mut von_mises = vec![0.0; mesh.hexes.len()];

@@ -74,14 +74,21 @@ pub fn nodal_values(frame: &Frame, name: &str) -> Result<Vec<f64>> {
     )))
 }
 
+/// What a field map shows besides its field: where the points are, which tool's contact
+/// values (and faces) it shows, and the length unit of its axes.
+#[derive(Clone, Debug, Default)]
+pub struct MapView {
+    pub configuration: Configuration,
+    /// Only the nodes this tool has touched (in contact now, or with frictional work or
+    /// slip against it) carry values; the rest of the face set is drawn grey.
+    pub tool: Option<String>,
+    /// Unit of x and y ("mm"); empty for none.
+    pub length_unit: String,
+}
+
 /// The colour map of field `field` on the boundary faces within node set `face_set`,
 /// seen along -z (x right, y up), at the committed state of `sim`.
-pub fn field_map(
-    sim: &Simulation,
-    face_set: &str,
-    field: &str,
-    configuration: Configuration,
-) -> Result<FieldMap> {
+pub fn field_map(sim: &Simulation, face_set: &str, field: &str, view: &MapView) -> Result<FieldMap> {
     let mesh = &sim.model.mesh;
     let nodes = mesh.node_set(face_set)?;
     let quads = mesh.faces_within(nodes)?;
@@ -90,24 +97,92 @@ pub fn field_map(
             "node set '{face_set}' holds no boundary face to draw"
         )));
     }
-    let frame = super::blank_frame::frame(sim, Configuration::Reference);
-    let values = nodal_values(&frame, field)?;
+    let tool = view
+        .tool
+        .as_deref()
+        .map(|name| sim.model.tool_index(name))
+        .transpose()?;
+    let frame = super::blank_frame::frame_against(sim, Configuration::Reference, tool);
+    let mut values = nodal_values(&frame, field)?;
+    if let Some(c) = tool {
+        let mut touched = vec![false; values.len()];
+        for (k, s) in sim.contact_states(c).iter().enumerate() {
+            touched[sim.model.contacts[c].candidates[k]] =
+                s.status.is_active() || s.work > 0.0 || s.slip > 0.0;
+        }
+        for (v, t) in values.iter_mut().zip(&touched) {
+            if !t {
+                *v = f64::NAN;
+            }
+        }
+    }
     let u = sim.displacements();
     let points = mesh
         .nodes
         .iter()
         .enumerate()
-        .map(|(i, p)| match configuration {
-            Configuration::Reference => [p.x, p.y],
-            Configuration::Current => [p.x + u[3 * i], p.y + u[3 * i + 1]],
+        .map(|(i, p)| {
+            let [x, y, _] = view.configuration.place(p, &u[3 * i..3 * i + 3]);
+            [x, y]
         })
         .collect();
+    let axis = |name: &str| match view.length_unit.as_str() {
+        "" => name.to_string(),
+        unit => format!("{name} [{unit}]"),
+    };
+    let on = match &view.tool {
+        Some(t) => format!("{face_set} touched by {t}"),
+        None => face_set.to_string(),
+    };
     Ok(FieldMap {
-        title: format!("{field} on {face_set}, t = {}", super::fmt_f64(sim.time())),
+        title: format!("{field} on {on}, t = {}", super::significant(sim.time(), 6)),
         label: field.to_string(),
         points,
         values,
         quads,
         range: None,
+        x_label: axis("x"),
+        y_label: axis("y"),
     })
+}
+
+/// The colour range a friction law gives `field`: for `mu`, from the smallest to the
+/// largest control point of the Bernstein laws (mu_cut to mu_init for a decreasing law)
+/// or the Coulomb coefficients, of tool `tool` or of every tool. Error for another field,
+/// or when every law is external (a script function).
+pub fn law_range(sim: &Simulation, field: &str, tool: Option<&str>) -> Result<(f64, f64)> {
+    if field != "mu" {
+        return Err(Error::Input(format!(
+            "range \"law\" is defined for the field mu only, not '{field}'"
+        )));
+    }
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for c in &sim.model.contacts {
+        if tool.is_some_and(|t| t != c.tool.name) {
+            continue;
+        }
+        let mus: Vec<f64> = match &c.tool.friction {
+            crate::contact::FrictionLaw::Coulomb { mu } => vec![*mu],
+            crate::contact::FrictionLaw::Bernstein(law) => law.control_points().to_vec(),
+            _ => Vec::new(),
+        };
+        for mu in mus {
+            lo = lo.min(mu);
+            hi = hi.max(mu);
+        }
+    }
+    if let Some(t) = tool {
+        sim.model.tool_index(t)?;
+    }
+    if lo > hi {
+        return Err(Error::Input(
+            "range \"law\": no Coulomb or Bernstein law to take the range from".into(),
+        ));
+    }
+    if lo == hi {
+        // One constant coefficient: centre it in a range of +-10 %.
+        let pad = if lo == 0.0 { 0.01 } else { 0.1 * lo.abs() };
+        return Ok((lo - pad, hi + pad));
+    }
+    Ok((lo, hi))
 }

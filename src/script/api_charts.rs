@@ -6,7 +6,7 @@
 use super::api_sim::ScriptSim;
 use super::convert::*;
 use super::HostOptions;
-use crate::output::field_chart::{field_map, Configuration};
+use crate::output::field_chart::{field_map, law_range, Configuration, MapView};
 use crate::output::svg::{LineChart, Series};
 use crate::output::OutputFolder;
 use rhai::{Array, Dynamic, Engine, Map};
@@ -105,6 +105,13 @@ fn line_chart_spec(spec: &Map) -> ScriptResult<LineChart> {
     Ok(chart)
 }
 
+/// The colour range of a field map: the drawn values', a fixed one, or the friction law's.
+enum Range {
+    Data,
+    Fixed(f64, f64),
+    Law,
+}
+
 /// Largest magnitude a chart accepts.
 const CHART_LIMIT: f64 = 1e300;
 
@@ -121,36 +128,50 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     engine.register_fn(
         "chart_field",
         move |s: &mut ScriptSim, file: &str, face_set: &str, field: &str, options: Map| -> ScriptResult<()> {
-            let mut configuration = Configuration::Current;
-            let (mut title, mut label, mut range) = (None, None, None);
+            let mut view = MapView::default();
+            let (mut title, mut label) = (None, None);
+            let mut range = Range::Data;
             for (key, v) in &options {
                 match key.as_str() {
                     "title" => title = Some(string(v, "chart title")?),
                     "label" => label = Some(string(v, "colour bar label")?),
+                    "tool" => view.tool = Some(string(v, "tool")?),
                     "configuration" => {
-                        configuration = lift(Configuration::parse(&string(v, "configuration")?))?
+                        view.configuration = lift(Configuration::parse(&string(v, "configuration")?))?
+                    }
+                    "range" if v.is_string() => {
+                        let name = string(v, "range")?;
+                        if name != "law" {
+                            return runtime_error(format!("range = \"{name}\" must be \"law\" or [low, high]"));
+                        }
+                        range = Range::Law;
                     }
                     "range" => {
                         let r = numbers(v, "range")?;
                         if r.len() != 2 {
-                            return runtime_error(format!("range must be [low, high], got {} numbers", r.len()));
+                            return runtime_error(format!("range must be [low, high] or \"law\", got {} numbers", r.len()));
                         }
-                        range = Some((r[0], r[1]));
+                        range = Range::Fixed(r[0], r[1]);
                     }
                     other => {
                         return runtime_error(format!(
-                            "unknown chart_field option '{other}' (known: title, label, range, configuration)"
+                            "unknown chart_field option '{other}' (known: title, label, range, configuration, tool)"
                         ))
                     }
                 }
             }
             let path = chart_path(&h, file)?;
             let mut st = s.borrow_mut();
+            view.length_unit = st.length_unit();
             let sim = st.simulation()?;
-            let mut map = lift(field_map(sim, face_set, field, configuration))?;
+            let mut map = lift(field_map(sim, face_set, field, &view))?;
             map.title = title.unwrap_or(map.title);
             map.label = label.unwrap_or(map.label);
-            map.range = range;
+            map.range = match range {
+                Range::Data => None,
+                Range::Fixed(lo, hi) => Some((lo, hi)),
+                Range::Law => Some(lift(law_range(sim, field, view.tool.as_deref()))?),
+            };
             lift(map.write(&path).map(|_| ()))
         },
     );

@@ -413,6 +413,11 @@ impl SimState {
         })
     }
 
+    /// The length unit named in the output settings ("" when none was set).
+    pub(super) fn length_unit(&self) -> String {
+        self.frames.units.length.clone()
+    }
+
     /// What the script keeps (`sim.keep`), as checkpoints store it.
     pub(super) fn keep(&mut self, name: &str, value: serde_json::Value) {
         self.kept.insert(name.to_string(), value);
