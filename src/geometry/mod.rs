@@ -15,6 +15,7 @@ pub mod cylinder;
 pub mod patch_surface;
 pub mod patch_table;
 pub mod plane;
+pub mod revolution;
 pub mod seams;
 pub mod sphere;
 #[cfg(test)]

@@ -78,7 +78,7 @@ pub fn core_and_growth(
     }
     let cells = (core[1] - core[0]) / size;
     let n = cells.round();
-    if (cells - n).abs() > 1e-9 * cells.max(1.0) || n < 1.0 || n > 1e6 {
+    if (cells - n).abs() > 1e-9 * cells.max(1.0) || !(1.0..=1e6).contains(&n) {
         return Err(Error::input(
             "graded line core cell size",
             size,

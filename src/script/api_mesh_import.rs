@@ -15,6 +15,90 @@ pub fn register(engine: &mut Engine, policy: Rc<ReadPolicy>, limits: super::limi
     register_files(engine, policy, limits.clone());
     register_structured(engine, limits);
     register_set_names(engine);
+    register_round_tools(engine);
+}
+
+/// `spec.key` as a number, or `default` when absent (`None`: the key is required).
+fn field(spec: &rhai::Map, key: &str, default: Option<f64>, what: &str) -> ScriptResult<f64> {
+    match (spec.get(key), default) {
+        (Some(v), _) => number(v, &format!("{what}.{key}")),
+        (None, Some(d)) => Ok(d),
+        (None, None) => runtime_error(format!("{what} needs the key `{key}`")),
+    }
+}
+
+fn revolved(
+    spec: &rhai::Map,
+    what: &str,
+    keys: &[&str],
+    profile: impl Fn(&[f64]) -> crate::Result<Vec<crate::geometry::revolution::Segment>>,
+) -> ScriptResult<super::api_scene::ScriptSurface> {
+    use crate::geometry::revolution::{revolve, Revolution};
+    for key in spec.keys() {
+        if !keys.contains(&key.as_str()) && key != "level" && key != "quarter" {
+            return runtime_error(format!(
+                "{what}: unknown key `{key}` (keys: {}, level, quarter)",
+                keys.join(", ")
+            ));
+        }
+    }
+    let values = keys
+        .iter()
+        .map(|k| field(spec, k, None, what))
+        .collect::<ScriptResult<Vec<f64>>>()?;
+    let mut args = values;
+    args.push(field(spec, "level", Some(0.0), what)?);
+    let quarter = match spec.get("quarter") {
+        Some(v) => v
+            .as_bool()
+            .or_else(|_| runtime_error(format!("{what}.quarter must be true or false")))?,
+        None => false,
+    };
+    let extent = if quarter {
+        Revolution::Quarter
+    } else {
+        Revolution::Full
+    };
+    let patches = lift(revolve(&lift(profile(&args))?, extent))?;
+    Ok(super::api_scene::ScriptSurface(std::sync::Arc::new(lift(
+        crate::geometry::PatchSurface::new(patches),
+    )?)))
+}
+
+fn register_round_tools(engine: &mut Engine) {
+    use crate::geometry::revolution::{round_die, round_holder, round_punch};
+    // round_punch(#{ radius, nose_radius, wall_height, level: 0, quarter: false })
+    engine.register_fn("round_punch", |spec: rhai::Map| {
+        revolved(
+            &spec,
+            "round_punch",
+            &["radius", "nose_radius", "wall_height"],
+            |a| round_punch(a[0], a[1], a[2], a[3]),
+        )
+    });
+    // round_die(#{ opening_radius, entry_radius, flat_extent, wall_depth, level, quarter })
+    engine.register_fn("round_die", |spec: rhai::Map| {
+        revolved(
+            &spec,
+            "round_die",
+            &[
+                "opening_radius",
+                "entry_radius",
+                "flat_extent",
+                "wall_depth",
+            ],
+            |a| round_die(a[0], a[1], a[2], a[3], a[4]),
+        )
+    });
+    // round_holder(#{ inner_radius, outer_radius, level, quarter })
+    engine.register_fn("round_holder", |spec: rhai::Map| {
+        revolved(
+            &spec,
+            "round_holder",
+            &["inner_radius", "outer_radius"],
+            |a| round_holder(a[0], a[1], a[2]),
+        )
+    });
 }
 
 fn numbers(a: &Array, what: &str) -> ScriptResult<Vec<f64>> {
