@@ -628,7 +628,12 @@ fn frame(what: &str, axis: &Vec3, reference: &Vec3, angle: f64) -> Result<(Vec3,
 /// `(p + tan(sweep/2) q) `, end, weights `1, cos(sweep/2), 1`. The 90° arc uses the exact
 /// values `p + q` and `1/sqrt2`. Sweeps in (0, 120°] (beyond, the middle weight gets small
 /// and the parametrisation uneven).
-fn circular_arc(what: &str, p: Vec3, q: Vec3, sweep: f64) -> Result<([Vec3; 3], [f64; 3])> {
+pub(crate) fn circular_arc(
+    what: &str,
+    p: Vec3,
+    q: Vec3,
+    sweep: f64,
+) -> Result<([Vec3; 3], [f64; 3])> {
     let limit = 2.0 * std::f64::consts::FRAC_PI_3;
     if !sweep.is_finite() || sweep <= 0.0 || sweep > limit * (1.0 + 1e-12) {
         return Err(Error::input(

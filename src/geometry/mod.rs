@@ -16,6 +16,7 @@ pub mod nurbs;
 pub mod patch_surface;
 pub mod patch_table;
 pub mod plane;
+pub mod revolution;
 pub mod seams;
 pub mod sphere;
 #[cfg(test)]

@@ -102,7 +102,14 @@ impl Mesh {
         let coords: Vec<Vec<f64>> = (0..3)
             .map(|d| axis_coordinates(d, origin[d], size[d], cells[d], grading[d]))
             .collect::<Result<_>>()?;
+        Ok(Mesh::grid(&coords, node_count))
+    }
 
+    /// The structured grid on the node coordinates `coords[d]` along axis `d` (each
+    /// strictly increasing, checked by the caller), numbered, with face sets and columns,
+    /// as [`Mesh::block_graded`] documents.
+    pub(super) fn grid(coords: &[Vec<f64>], node_count: usize) -> Mesh {
+        let cells = [0, 1, 2].map(|d| coords[d].len() - 1);
         let [nx, ny, nz] = cells;
         let node = |i: usize, j: usize, k: usize| i + (nx + 1) * (j + (ny + 1) * k);
 
@@ -159,13 +166,13 @@ impl Mesh {
             .flat_map(|j| (0..=nx).map(move |i| (i, j)))
             .map(|(i, j)| (0..=nz).map(|k| node(i, j, k)).collect())
             .collect();
-        Ok(Mesh {
+        Mesh {
             nodes,
             hexes,
             node_sets,
             columns,
             ..Mesh::default()
-        })
+        }
     }
 }
 

@@ -12,8 +12,153 @@ use std::path::Path;
 use std::rc::Rc;
 
 pub fn register(engine: &mut Engine, policy: Rc<ReadPolicy>, limits: super::limits::Limits) {
-    register_files(engine, policy, limits);
+    register_files(engine, policy, limits.clone());
+    register_structured(engine, limits);
     register_set_names(engine);
+    register_round_tools(engine);
+}
+
+/// `spec.key` as a number, or `default` when absent (`None`: the key is required).
+fn field(spec: &rhai::Map, key: &str, default: Option<f64>, what: &str) -> ScriptResult<f64> {
+    match (spec.get(key), default) {
+        (Some(v), _) => number(v, &format!("{what}.{key}")),
+        (None, Some(d)) => Ok(d),
+        (None, None) => runtime_error(format!("{what} needs the key `{key}`")),
+    }
+}
+
+fn revolved(
+    spec: &rhai::Map,
+    what: &str,
+    keys: &[&str],
+    profile: impl Fn(&[f64]) -> crate::Result<Vec<crate::geometry::revolution::Segment>>,
+) -> ScriptResult<super::api_scene::ScriptSurface> {
+    use crate::geometry::revolution::{revolve, Revolution};
+    for key in spec.keys() {
+        if !keys.contains(&key.as_str()) && key != "level" && key != "quarter" {
+            return runtime_error(format!(
+                "{what}: unknown key `{key}` (keys: {}, level, quarter)",
+                keys.join(", ")
+            ));
+        }
+    }
+    let values = keys
+        .iter()
+        .map(|k| field(spec, k, None, what))
+        .collect::<ScriptResult<Vec<f64>>>()?;
+    let mut args = values;
+    args.push(field(spec, "level", Some(0.0), what)?);
+    let quarter = match spec.get("quarter") {
+        Some(v) => v
+            .as_bool()
+            .or_else(|_| runtime_error(format!("{what}.quarter must be true or false")))?,
+        None => false,
+    };
+    let extent = if quarter {
+        Revolution::Quarter
+    } else {
+        Revolution::Full
+    };
+    let patches = lift(revolve(&lift(profile(&args))?, extent))?;
+    Ok(super::api_scene::ScriptSurface(std::sync::Arc::new(lift(
+        crate::geometry::PatchSurface::new(patches),
+    )?)))
+}
+
+fn register_round_tools(engine: &mut Engine) {
+    use crate::geometry::revolution::{round_die, round_holder, round_punch};
+    // round_punch(#{ radius, nose_radius, wall_height, level: 0, quarter: false })
+    engine.register_fn("round_punch", |spec: rhai::Map| {
+        revolved(
+            &spec,
+            "round_punch",
+            &["radius", "nose_radius", "wall_height"],
+            |a| round_punch(a[0], a[1], a[2], a[3]),
+        )
+    });
+    // round_die(#{ opening_radius, entry_radius, flat_extent, wall_depth, level, quarter })
+    engine.register_fn("round_die", |spec: rhai::Map| {
+        revolved(
+            &spec,
+            "round_die",
+            &[
+                "opening_radius",
+                "entry_radius",
+                "flat_extent",
+                "wall_depth",
+            ],
+            |a| round_die(a[0], a[1], a[2], a[3], a[4]),
+        )
+    });
+    // round_holder(#{ inner_radius, outer_radius, level, quarter })
+    engine.register_fn("round_holder", |spec: rhai::Map| {
+        revolved(
+            &spec,
+            "round_holder",
+            &["inner_radius", "outer_radius"],
+            |a| round_holder(a[0], a[1], a[2]),
+        )
+    });
+}
+
+fn numbers(a: &Array, what: &str) -> ScriptResult<Vec<f64>> {
+    a.iter()
+        .enumerate()
+        .map(|(i, v)| number(v, &format!("{what}[{i}]")))
+        .collect()
+}
+
+fn to_array(x: &[f64]) -> Array {
+    x.iter().map(|&v| Dynamic::from(v)).collect()
+}
+
+fn register_structured(engine: &mut Engine, limits: super::limits::Limits) {
+    // block_lines(xs, ys, zs): the structured block on explicit node coordinates.
+    engine.register_fn(
+        "block_lines",
+        move |x: Array, y: Array, z: Array| -> ScriptResult<Mesh> {
+            let nodes = (x.len() as u64)
+                .saturating_mul(y.len() as u64)
+                .saturating_mul(z.len() as u64);
+            limits.check_mesh(nodes).or_else(runtime_error)?;
+            lift(Mesh::block_lines(
+                &numbers(&x, "block_lines x")?,
+                &numbers(&y, "block_lines y")?,
+                &numbers(&z, "block_lines z")?,
+            ))
+        },
+    );
+    // graded_line([c0, c1], h, ratio, [e0, e1]): uniform cells h on the core, geometric
+    // growth by ratio outward to the extent.
+    engine.register_fn(
+        "graded_line",
+        |core: Array, size: Dynamic, ratio: Dynamic, extent: Array| -> ScriptResult<Array> {
+            let pair = |a: &Array, what: &str| -> ScriptResult<[f64; 2]> {
+                match numbers(a, what)?.as_slice() {
+                    [lo, hi] => Ok([*lo, *hi]),
+                    _ => runtime_error(format!("{what} must be [start, end]")),
+                }
+            };
+            Ok(to_array(&lift(crate::mesh::core_and_growth(
+                pair(&core, "graded_line core")?,
+                number(&size, "graded_line cell size")?,
+                number(&ratio, "graded_line ratio")?,
+                pair(&extent, "graded_line extent")?,
+            ))?))
+        },
+    );
+    // a.merge(b [, tolerance]): the meshes as one, nodes of b within the tolerance (default
+    // 1e-9 times the larger bounding-box diagonal) of nodes of a merged into them.
+    engine.register_fn("merge", |a: &mut Mesh, b: Mesh| -> ScriptResult<Mesh> {
+        let diag = |m: &Mesh| m.bounding_box().map_or(1.0, |(lo, hi)| (hi - lo).norm());
+        lift(a.merged(&b, 1e-9 * diag(a).max(diag(&b))))
+    });
+    engine.register_fn(
+        "merge",
+        |a: &mut Mesh, b: Mesh, tolerance: Dynamic| -> ScriptResult<Mesh> {
+            lift(a.merged(&b, number(&tolerance, "merge tolerance")?))
+        },
+    );
 }
 
 /// The path a script gave, relative to the script's folder when it is relative.
