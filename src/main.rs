@@ -75,6 +75,14 @@ enum Command {
         /// Folder for the scripts and the runs' outputs (default: under the system temp).
         #[arg(long)]
         work_dir: Option<PathBuf>,
+        /// The baseline's own scripts folder (default: TREE/scripts for a baseline at
+        /// TREE/target/release/tribo; else this binary's scripts).
+        #[arg(long)]
+        baseline_scripts: Option<PathBuf>,
+        /// Processors each run is pinned to (the engine then uses as many element threads);
+        /// 0: all.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
     },
     /// Interactive stepping; loads SCRIPT's scene first if given.
     Repl {
@@ -175,6 +183,8 @@ fn main() -> ExitCode {
             baseline,
             json,
             work_dir,
+            baseline_scripts,
+            threads,
         } => (|| {
             let opts = tribo::bench::BenchOptions {
                 cases: case,
@@ -184,6 +194,8 @@ fn main() -> ExitCode {
                 baseline,
                 json,
                 work_dir,
+                baseline_scripts,
+                threads,
             };
             let this = std::env::current_exe()
                 .map_err(|e| tribo::Error::Input(format!("bench: own binary: {e}")))?;
