@@ -22,9 +22,10 @@
 //! # One thread
 //!
 //! `--threads N` (default 1; 0 for every core) pins each child to `N` of the processors this
-//! process may use (Linux `sched_setaffinity`), so that the engine's default of one element
-//! thread per available core gives `N`: CPU seconds per iteration with one thread are the
-//! cost of the iteration itself, free of threading overheads and of the machine's load.
+//! process may use (Linux `sched_setaffinity`; elsewhere runs are not pinned), so that the
+//! engine's default of one element thread per available core gives `N`: CPU seconds per
+//! iteration with one thread are the cost of the iteration itself, free of threading
+//! overheads.
 
 use crate::{Error, Result};
 use serde::Serialize;
@@ -292,14 +293,17 @@ fn split_sets(sets: &[String], script: &str) -> (Vec<String>, Vec<String>) {
     })
 }
 
-/// The first `n` processors this process may use, as an affinity mask for a child (None:
-/// no pinning, `n = 0` or the mask cannot be read).
-fn affinity(n: usize) -> Option<(libc::cpu_set_t, usize)> {
+/// Pins the child `command` will start to the first `n` processors this process may use
+/// (Linux; `n = 0`, or elsewhere: no pinning). Returns how many it was given, None when not
+/// pinned.
+#[cfg(target_os = "linux")]
+fn pin_child(command: &mut std::process::Command, n: usize) -> Option<usize> {
+    use std::os::unix::process::CommandExt;
     if n == 0 {
         return None;
     }
     // SAFETY: cpu_set_t is plain data; sched_getaffinity writes at most its size.
-    unsafe {
+    let (set, taken) = unsafe {
         let mut own: libc::cpu_set_t = std::mem::zeroed();
         if libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut own) != 0 {
             return None;
@@ -312,8 +316,27 @@ fn affinity(n: usize) -> Option<(libc::cpu_set_t, usize)> {
                 taken += 1;
             }
         }
-        (taken > 0).then_some((set, taken))
+        (set, taken)
+    };
+    if taken == 0 {
+        return None;
     }
+    // SAFETY: the closure runs in the child between fork and exec and only calls
+    // sched_setaffinity (async-signal-safe) on a mask prepared before the fork.
+    unsafe {
+        command.pre_exec(move || {
+            if libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    Some(taken)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn pin_child(_command: &mut std::process::Command, _n: usize) -> Option<usize> {
+    None
 }
 
 fn measure(
@@ -333,20 +356,7 @@ fn measure(
         .arg("--out")
         .arg(out)
         .args(sets.iter().flat_map(|s| ["--set", s.as_str()]));
-    let pinned = affinity(threads);
-    if let Some((set, _)) = pinned {
-        use std::os::unix::process::CommandExt;
-        // SAFETY: the closure runs in the child between fork and exec and only calls
-        // sched_setaffinity (async-signal-safe) on a mask prepared before the fork.
-        unsafe {
-            command.pre_exec(move || {
-                if libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) != 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                Ok(())
-            });
-        }
-    }
+    let pinned = pin_child(&mut command, threads);
     let cpu0 = children_cpu_seconds();
     let start = Instant::now();
     let output = command
@@ -410,7 +420,7 @@ fn measure(
         wall_s,
         ms_per_iteration: 1e3 * cpu_s.unwrap_or(wall_s) / iterations,
         wall_ms_per_iteration: 1e3 * wall_s / iterations,
-        threads: pinned.map(|(_, n)| n),
+        threads: pinned,
     })
 }
 
