@@ -75,6 +75,14 @@ enum Command {
         /// Folder for the scripts and the runs' outputs (default: under the system temp).
         #[arg(long)]
         work_dir: Option<PathBuf>,
+        /// The baseline's own scripts folder (default: TREE/scripts for a baseline at
+        /// TREE/target/release/tribo; else this binary's scripts).
+        #[arg(long)]
+        baseline_scripts: Option<PathBuf>,
+        /// Processors each run is pinned to (the engine then uses as many element threads);
+        /// 0: all.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
     },
     /// A family of runs of SCRIPT, one per row of TABLE.csv (its columns become --set
     /// NAME=VALUE), here on --jobs processes or written out for a cluster (--emit); then
@@ -267,6 +275,8 @@ fn main() -> ExitCode {
             baseline,
             json,
             work_dir,
+            baseline_scripts,
+            threads,
         } => (|| {
             let opts = tribo::bench::BenchOptions {
                 cases: case,
@@ -276,6 +286,8 @@ fn main() -> ExitCode {
                 baseline,
                 json,
                 work_dir,
+                baseline_scripts,
+                threads,
             };
             let this = std::env::current_exe()
                 .map_err(|e| tribo::Error::Input(format!("bench: own binary: {e}")))?;

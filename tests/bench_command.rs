@@ -18,6 +18,12 @@ fn bench(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// The summary.json of a measurement's run.
+fn summary_of(m: &serde_json::Value) -> serde_json::Value {
+    let out_dir = std::path::Path::new(m["out_dir"].as_str().unwrap());
+    serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap()
+}
+
 #[test]
 fn argument_errors_name_the_fault() {
     for (args, needle) in [
@@ -60,7 +66,7 @@ fn reported_counts_are_the_runs_own() {
     ]);
     assert_eq!(code, 0, "{stderr}");
     assert!(
-        stdout.contains("case drag (cells=8)") && stdout.contains("base/this"),
+        stdout.contains("case drag (cells=8;") && stdout.contains("base/this"),
         "{stdout}"
     );
     let results: serde_json::Value =
@@ -70,11 +76,7 @@ fn reported_counts_are_the_runs_own() {
     let mut counts = Vec::new();
     for key in ["this", "baseline"] {
         let m = &results[0][key];
-        let out_dir = m["out_dir"].as_str().unwrap();
-        let summary: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(std::path::Path::new(out_dir).join("summary.json")).unwrap(),
-        )
-        .unwrap();
+        let summary = summary_of(m);
         for field in [
             "newton_iterations",
             "line_search_cuts",
@@ -106,5 +108,70 @@ fn reported_counts_are_the_runs_own() {
         counts.push((it, cuts, m["increments"].clone()));
     }
     assert_eq!(counts[0], counts[1]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A baseline built in another checkout runs that checkout's own script, with only the
+/// overrides that script declares: here a baseline tree (`TREE/target/release/tribo`, a
+/// link to this binary) whose drag script has no `cells` (its mesh is fixed at 8 cells).
+/// The run succeeds, the baseline's mesh is its script's (54 nodes, not the 13 x 2 x 4 of
+/// `--cells 12`), the table names the override left out, and the evaluation counts are the
+/// runs' own.
+#[test]
+fn baseline_runs_its_own_script_with_the_settings_it_declares() {
+    let dir = std::env::temp_dir().join(format!("tribo-bench-own-{}", std::process::id()));
+    let tree = dir.join("tree");
+    std::fs::create_dir_all(tree.join("target/release")).unwrap();
+    std::fs::create_dir_all(tree.join("scripts")).unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let drag = std::fs::read_to_string(root.join("scripts/cylinder_drag.rhai")).unwrap();
+    assert!(drag.contains("let cells = 32;"));
+    let old = drag
+        .replace("let cells = 32;", "let n_cells = 8;")
+        .replace("[cells, 1, cells / 4]", "[n_cells, 1, n_cells / 4]");
+    std::fs::write(tree.join("scripts/cylinder_drag.rhai"), old).unwrap();
+    let baseline = tree.join("target/release/tribo");
+    std::os::unix::fs::symlink(env!("CARGO_BIN_EXE_tribo"), &baseline).unwrap();
+    let json = dir.join("bench.json");
+    let (code, stdout, stderr) = bench(&[
+        "--case",
+        "drag",
+        "--cells",
+        "12",
+        "--baseline",
+        baseline.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+        "--work-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains("left out, not declared by that script: cells=12"),
+        "{stdout}"
+    );
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let (this, base) = (&results[0]["this"], &results[0]["baseline"]);
+    assert_eq!(this["nodes"].as_u64().unwrap(), 13 * 2 * 4);
+    assert_eq!(base["nodes"].as_u64().unwrap(), 54);
+    assert_eq!(base["sets_left_out"][0], "cells=12");
+    assert!(base["script"]
+        .as_str()
+        .unwrap()
+        .ends_with("tree/scripts/cylinder_drag.rhai"));
+    assert_eq!(this["threads"].as_u64(), Some(1), "pinned to one processor");
+    for m in [this, base] {
+        let summary = summary_of(m);
+        let it = summary["newton_iterations"].as_f64().unwrap();
+        let full = summary["evaluations"]["full"].as_f64().unwrap();
+        // At least one full evaluation per Newton iteration (each step solves with one).
+        assert!(full >= it, "{summary}");
+        assert_eq!(m["full_evaluations_per_iteration"].as_f64().unwrap(), full / it);
+        assert_eq!(
+            m["residual_evaluations_per_iteration"].as_f64().unwrap(),
+            summary["evaluations"]["residual_only"].as_f64().unwrap() / it
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

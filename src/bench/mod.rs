@@ -9,6 +9,23 @@
 //! are the child's user + system time (Linux: the parent's `cutime + cstime` in
 //! `/proc/self/stat` before and after waiting for it, 1/100 s resolution), wall seconds the
 //! parent's clock around the child. The numbers are reported, never judged.
+//!
+//! # Comparing builds whose scripts differ
+//!
+//! A baseline built from an older checkout may not know the current script's settings or
+//! functions. So each binary runs its own checkout's script when there is one: for a
+//! baseline at `TREE/target/release/tribo` (or with `--baseline-scripts DIR`), the script of
+//! the same name in `TREE/scripts/`; otherwise this binary's copy. And each binary gets only
+//! the `--set` overrides its script declares (a top-level `let NAME = ...;`); the table
+//! lists what was left out.
+//!
+//! # One thread
+//!
+//! `--threads N` (default 1; 0 for every core) pins each child to `N` of the processors this
+//! process may use (Linux `sched_setaffinity`; elsewhere runs are not pinned), so that the
+//! engine's default of one element thread per available core gives `N`: CPU seconds per
+//! iteration with one thread are the cost of the iteration itself, free of threading
+//! overheads.
 
 pub mod floor;
 
@@ -41,14 +58,21 @@ pub struct BenchOptions {
     pub json: Option<PathBuf>,
     /// Folder for scripts and run outputs (default: a folder under the system's temp).
     pub work_dir: Option<PathBuf>,
+    /// The baseline's scripts folder (default: `TREE/scripts` of a baseline at
+    /// `TREE/target/<profile>/tribo`, if it holds the case's script).
+    pub baseline_scripts: Option<PathBuf>,
+    /// Processors each run may use (0: all this process may use).
+    pub threads: usize,
 }
 
 /// One case, checked and ready to run.
 #[derive(Clone, Debug, Serialize)]
 pub struct Case {
     pub name: String,
-    /// The `--set` overrides passed to the script.
+    /// The `--set` overrides asked for (each binary gets those its script declares).
     pub sets: Vec<String>,
+    /// The script's file name (`scripts/NAME` of a checkout).
+    pub script_name: &'static str,
     #[serde(skip)]
     script: &'static str,
 }
@@ -57,6 +81,11 @@ pub struct Case {
 #[derive(Clone, Debug, Serialize)]
 pub struct Measurement {
     pub binary: String,
+    /// The script this binary ran (its own checkout's, or this binary's copy).
+    pub script: PathBuf,
+    /// The overrides passed, and those left out because the script does not declare them.
+    pub sets: Vec<String>,
+    pub sets_left_out: Vec<String>,
     /// The run's output folder (its summary.json is where every count comes from).
     pub out_dir: PathBuf,
     pub nodes: usize,
@@ -68,12 +97,21 @@ pub struct Measurement {
     /// Trial states evaluated per Newton iteration, (iterations + cuts) / iterations: the
     /// full step and each cut (predictors and re-evaluations not counted).
     pub trials_per_iteration: f64,
+    /// Element evaluations per Newton iteration, full (with tangents) and residual-only,
+    /// from the run's own count (`evaluations` in summary.json; None for a binary that does
+    /// not record it).
+    pub full_evaluations_per_iteration: Option<f64>,
+    pub residual_evaluations_per_iteration: Option<f64>,
     /// Seconds per phase as the run recorded them.
     pub phase_times_s: BTreeMap<String, f64>,
     pub cpu_s: Option<f64>,
     pub wall_s: f64,
     /// cpu_s (or wall_s without it) per Newton iteration, in ms.
     pub ms_per_iteration: f64,
+    /// wall_s per Newton iteration, in ms.
+    pub wall_ms_per_iteration: f64,
+    /// Processors the run was pinned to (None: not pinned).
+    pub threads: Option<usize>,
 }
 
 /// A case with this binary's run and, with `--baseline`, the baseline's.
@@ -97,6 +135,13 @@ pub fn cases(opts: &BenchOptions) -> Result<Vec<Case>> {
     }
     if let Some(t) = opts.travel.filter(|t| !(*t > 0.0 && *t <= 60.0)) {
         return Err(Error::input("--travel", t, "must be in (0, 60] mm"));
+    }
+    if let Some(d) = opts.baseline_scripts.as_ref().filter(|d| !d.is_dir()) {
+        return Err(Error::input(
+            "--baseline-scripts",
+            d.display(),
+            "is not a folder (give the baseline checkout's scripts/)",
+        ));
     }
     if let Some(b) = &opts.baseline {
         if !b.is_file() {
@@ -124,9 +169,13 @@ pub fn cases(opts: &BenchOptions) -> Result<Vec<Case>> {
     Ok(names
         .into_iter()
         .map(|name| {
-            let (script, sets) = if name == "drag" {
+            let (script_name, script, sets) = if name == "drag" {
                 let cells = opts.cells.unwrap_or(32).max(4);
-                (CYLINDER_DRAG, vec![format!("cells={cells}")])
+                (
+                    "cylinder_drag.rhai",
+                    CYLINDER_DRAG,
+                    vec![format!("cells={cells}")],
+                )
             } else {
                 let variant = if name == "cup" { "paper" } else { "benchmark" };
                 let mut sets = vec![
@@ -138,9 +187,14 @@ pub fn cases(opts: &BenchOptions) -> Result<Vec<Case>> {
                 if let Some(t) = opts.travel {
                     sets.push(format!("travel={t:?}"));
                 }
-                (SQUARE_CUP, sets)
+                ("square_cup.rhai", SQUARE_CUP, sets)
             };
-            Case { name, sets, script }
+            Case {
+                name,
+                sets,
+                script_name,
+                script,
+            }
         })
         .collect())
 }
@@ -162,14 +216,19 @@ pub fn run(opts: &BenchOptions, this: &Path) -> Result<Vec<CaseResult>> {
             &script,
             &case,
             &work.join(format!("{}-this", case.name)),
+            opts.threads,
         )?;
         let base_run = match &opts.baseline {
-            Some(b) => Some(measure(
-                b,
-                &script,
-                &case,
-                &work.join(format!("{}-baseline", case.name)),
-            )?),
+            Some(b) => {
+                let own = baseline_script(b, opts.baseline_scripts.as_deref(), case.script_name);
+                Some(measure(
+                    b,
+                    own.as_deref().unwrap_or(&script),
+                    &case,
+                    &work.join(format!("{}-baseline", case.name)),
+                    opts.threads,
+                )?)
+            }
             None => None,
         };
         let result = CaseResult {
@@ -199,16 +258,110 @@ fn children_cpu_seconds() -> Option<f64> {
     Some(ticks / 100.0)
 }
 
-fn measure(binary: &Path, script: &Path, case: &Case, out: &Path) -> Result<Measurement> {
-    let cpu0 = children_cpu_seconds();
-    let start = Instant::now();
-    let output = std::process::Command::new(binary)
+/// The baseline's own script for `name`: in `scripts_dir` if given, else in the checkout
+/// the binary was built in (`TREE/target/<profile>/tribo` -> `TREE/scripts/name`); None
+/// when there is none (this binary's copy is used).
+fn baseline_script(binary: &Path, scripts_dir: Option<&Path>, name: &str) -> Option<PathBuf> {
+    let dir = match scripts_dir {
+        Some(d) => d.to_path_buf(),
+        None => binary.parent()?.parent()?.parent()?.join("scripts"),
+    };
+    Some(dir.join(name)).filter(|p| p.is_file())
+}
+
+/// The names a script declares with a top-level `let NAME = ...;` (what `--set` may
+/// override): lines starting with `let` at column 0.
+pub fn declared_settings(script: &str) -> Vec<String> {
+    script
+        .lines()
+        .filter_map(|line| line.strip_prefix("let "))
+        .filter_map(|rest| {
+            let name: String = rest
+                .trim_start()
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            (!name.is_empty()).then_some(name)
+        })
+        .collect()
+}
+
+/// `sets` split into those `script` declares and those it does not.
+fn split_sets(sets: &[String], script: &str) -> (Vec<String>, Vec<String>) {
+    let declared = declared_settings(script);
+    sets.iter().cloned().partition(|s| {
+        let name = s.split('=').next().unwrap_or("").trim();
+        declared.iter().any(|d| d == name)
+    })
+}
+
+/// Pins the child `command` will start to the first `n` processors this process may use
+/// (Linux; `n = 0`, or elsewhere: no pinning). Returns how many it was given, None when not
+/// pinned.
+#[cfg(target_os = "linux")]
+fn pin_child(command: &mut std::process::Command, n: usize) -> Option<usize> {
+    use std::os::unix::process::CommandExt;
+    if n == 0 {
+        return None;
+    }
+    // SAFETY: cpu_set_t is plain data; sched_getaffinity writes at most its size.
+    let (set, taken) = unsafe {
+        let mut own: libc::cpu_set_t = std::mem::zeroed();
+        if libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut own) != 0 {
+            return None;
+        }
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        let mut taken = 0;
+        for cpu in 0..libc::CPU_SETSIZE as usize {
+            if taken < n && libc::CPU_ISSET(cpu, &own) {
+                libc::CPU_SET(cpu, &mut set);
+                taken += 1;
+            }
+        }
+        (set, taken)
+    };
+    if taken == 0 {
+        return None;
+    }
+    // SAFETY: the closure runs in the child between fork and exec and only calls
+    // sched_setaffinity (async-signal-safe) on a mask prepared before the fork.
+    unsafe {
+        command.pre_exec(move || {
+            if libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    Some(taken)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn pin_child(_command: &mut std::process::Command, _n: usize) -> Option<usize> {
+    None
+}
+
+fn measure(
+    binary: &Path,
+    script: &Path,
+    case: &Case,
+    out: &Path,
+    threads: usize,
+) -> Result<Measurement> {
+    let text = std::fs::read_to_string(script).map_err(|e| Error::io(script, e))?;
+    let (sets, sets_left_out) = split_sets(&case.sets, &text);
+    let mut command = std::process::Command::new(binary);
+    command
         .arg("run")
         .arg(script)
         .arg("--quiet")
         .arg("--out")
         .arg(out)
-        .args(case.sets.iter().flat_map(|s| ["--set", s.as_str()]))
+        .args(sets.iter().flat_map(|s| ["--set", s.as_str()]));
+    let pinned = pin_child(&mut command, threads);
+    let cpu0 = children_cpu_seconds();
+    let start = Instant::now();
+    let output = command
         .output()
         .map_err(|e| Error::Input(format!("bench: cannot start {}: {e}", binary.display())))?;
     let wall_s = start.elapsed().as_secs_f64();
@@ -249,8 +402,12 @@ fn measure(binary: &Path, script: &Path, case: &Case, out: &Path) -> Result<Meas
         })
         .unwrap_or_default();
     let iterations = newton_iterations.max(1) as f64;
+    let per_iteration = |key: &str| summary["evaluations"][key].as_f64().map(|v| v / iterations);
     Ok(Measurement {
         binary: binary.display().to_string(),
+        script: script.to_path_buf(),
+        sets,
+        sets_left_out,
         out_dir: out.to_path_buf(),
         nodes,
         displacement_unknowns: 3 * nodes,
@@ -258,15 +415,31 @@ fn measure(binary: &Path, script: &Path, case: &Case, out: &Path) -> Result<Meas
         newton_iterations,
         line_search_cuts,
         trials_per_iteration: (newton_iterations + line_search_cuts) as f64 / iterations,
+        full_evaluations_per_iteration: per_iteration("full"),
+        residual_evaluations_per_iteration: per_iteration("residual_only"),
         phase_times_s,
         cpu_s,
         wall_s,
         ms_per_iteration: 1e3 * cpu_s.unwrap_or(wall_s) / iterations,
+        wall_ms_per_iteration: 1e3 * wall_s / iterations,
+        threads: pinned,
     })
 }
 
+/// Evaluations per iteration as `full+residual` from the run's count, else the trials per
+/// iteration marked `~` (a binary that does not count its evaluations).
+fn evaluations_cell(m: &Measurement) -> String {
+    match (
+        m.full_evaluations_per_iteration,
+        m.residual_evaluations_per_iteration,
+    ) {
+        (Some(f), Some(r)) => format!("{f:.2}+{r:.2}"),
+        _ => format!("~{:.2}", m.trials_per_iteration),
+    }
+}
+
 /// The rows of one case: this binary, the baseline, and baseline / this (a speed-up above 1
-/// where this binary is faster).
+/// where this binary is faster); then which script each ran and any override left out.
 fn table(result: &CaseResult) -> String {
     let mut phases: Vec<String> = result.this.phase_times_s.keys().cloned().collect();
     if let Some(b) = &result.baseline {
@@ -276,8 +449,12 @@ fn table(result: &CaseResult) -> String {
             }
         }
     }
+    let threads = match result.this.threads {
+        Some(n) => format!("{n} processor(s) per run"),
+        None => "all processors".to_string(),
+    };
     let mut s = format!(
-        "\ncase {} ({})\n{:<9} {:>7} {:>5} {:>6} {:>5} {:>8}",
+        "\ncase {} ({}; {threads})\n{:<9} {:>7} {:>5} {:>6} {:>5} {:>11}",
         result.case.name,
         result.case.sets.join(" "),
         "binary",
@@ -285,20 +462,23 @@ fn table(result: &CaseResult) -> String {
         "incr",
         "iters",
         "cuts",
-        "trial/it"
+        "evals/it"
     );
     for p in &phases {
         s += &format!(" {:>12}", format!("{p} s"));
     }
-    s += &format!(" {:>8} {:>8} {:>9}\n", "cpu s", "wall s", "ms/iter");
+    s += &format!(
+        " {:>8} {:>8} {:>10} {:>10}\n",
+        "cpu s", "wall s", "cpu ms/it", "wall ms/it"
+    );
     let row = |label: &str, m: &Measurement| {
         let mut r = format!(
-            "{label:<9} {:>7} {:>5} {:>6} {:>5} {:>8.2}",
+            "{label:<9} {:>7} {:>5} {:>6} {:>5} {:>11}",
             m.displacement_unknowns,
             m.increments,
             m.newton_iterations,
             m.line_search_cuts,
-            m.trials_per_iteration
+            evaluations_cell(m)
         );
         for p in &phases {
             match m.phase_times_s.get(p) {
@@ -307,7 +487,13 @@ fn table(result: &CaseResult) -> String {
             }
         }
         let cpu = m.cpu_s.map_or("-".to_string(), |c| format!("{c:.2}"));
-        r += &format!(" {cpu:>8} {:>8.2} {:>9.2}\n", m.wall_s, m.ms_per_iteration);
+        let cpu_ms = m
+            .cpu_s
+            .map_or("-".to_string(), |_| format!("{:.2}", m.ms_per_iteration));
+        r += &format!(
+            " {cpu:>8} {:>8.2} {cpu_ms:>10} {:>10.2}\n",
+            m.wall_s, m.wall_ms_per_iteration
+        );
         r
     };
     s += &row("this", &result.this);
@@ -322,7 +508,7 @@ fn table(result: &CaseResult) -> String {
         };
         let t = &result.this;
         let mut r = format!(
-            "{:<9} {:>7} {:>5} {:>6} {:>5} {:>8}",
+            "{:<9} {:>7} {:>5} {:>6} {:>5} {:>11}",
             "base/this", "", "", "", "", ""
         );
         for p in &phases {
@@ -331,16 +517,31 @@ fn table(result: &CaseResult) -> String {
                 _ => r += &format!(" {:>12}", "-"),
             }
         }
-        let cpu = match (t.cpu_s, b.cpu_s) {
-            (Some(x), Some(y)) => ratio(x, y),
-            _ => "-".into(),
+        let (cpu, cpu_ms) = match (t.cpu_s, b.cpu_s) {
+            (Some(x), Some(y)) => (
+                ratio(x, y),
+                ratio(t.ms_per_iteration, b.ms_per_iteration),
+            ),
+            _ => ("-".into(), "-".into()),
         };
         r += &format!(
-            " {cpu:>8} {:>8} {:>9}\n",
+            " {cpu:>8} {:>8} {cpu_ms:>10} {:>10}\n",
             ratio(t.wall_s, b.wall_s),
-            ratio(t.ms_per_iteration, b.ms_per_iteration)
+            ratio(t.wall_ms_per_iteration, b.wall_ms_per_iteration)
         );
         s += &r;
+    }
+    for (label, m) in std::iter::once(("this", &result.this))
+        .chain(result.baseline.as_ref().map(|b| ("baseline", b)))
+    {
+        s += &format!("{label}: {}", m.script.display());
+        if !m.sets_left_out.is_empty() {
+            s += &format!(
+                " (left out, not declared by that script: {})",
+                m.sets_left_out.join(" ")
+            );
+        }
+        s += "\n";
     }
     s
 }
@@ -358,6 +559,8 @@ mod tests {
             baseline: None,
             json: None,
             work_dir: None,
+            baseline_scripts: None,
+            threads: 1,
         }
     }
 
@@ -388,5 +591,27 @@ mod tests {
             err.contains("--baseline") && err.contains("/no/such/tribo"),
             "{err}"
         );
+    }
+
+    /// Overrides go only to scripts that declare them; the shipped scripts declare every
+    /// override the cases pass.
+    #[test]
+    fn overrides_follow_the_script_declarations() {
+        let script = "// let commented = 1;\nlet cells = 4; // x\nlet  mu=0.2;\n  let inner = 1;\n";
+        assert_eq!(declared_settings(script), vec!["cells", "mu"]);
+        let sets = vec![
+            "cells=8".to_string(),
+            "inner=2".to_string(),
+            "mu=0.3".to_string(),
+        ];
+        let (kept, left) = split_sets(&sets, script);
+        assert_eq!(kept, vec!["cells=8".to_string(), "mu=0.3".to_string()]);
+        assert_eq!(left, vec!["inner=2".to_string()]);
+        let mut o = opts(&["all"]);
+        o.travel = Some(3.0);
+        for case in cases(&o).unwrap() {
+            let (_, left) = split_sets(&case.sets, case.script);
+            assert!(left.is_empty(), "{}: {left:?}", case.name);
+        }
     }
 }

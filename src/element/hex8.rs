@@ -217,11 +217,25 @@ impl Element<DOFS> for Hex8 {
         trial: &mut [PointState],
         material: &dyn Material,
     ) -> Result<ElementResponse<DOFS>> {
+        response_through_into(self, ref_coords, u, committed, trial, material)
+    }
+
+    /// `f = Σ_g B̄ᵀσ dV`, `K = Σ_g B̄ᵀ (D B̄ dV)` accumulated straight into the caller's
+    /// buffers (column-major `K`); residual only (`stiffness = None`): no tangent, the
+    /// material's stress update alone.
+    fn evaluate_into(
+        &self,
+        ref_coords: &[Vec3],
+        u: &[Vec3],
+        committed: &[PointState],
+        trial: &mut [PointState],
+        material: &dyn Material,
+        force: &mut [f64],
+        stiffness: Option<&mut [f64]>,
+    ) -> Result<()> {
+        let (force, mut stiffness) = cleared_outputs(force, stiffness)?;
         let (_, u, geo) = checked_inputs(ref_coords, u, committed, trial)?;
         let ue = SVector::<f64, DOFS>::from_fn(|i, _| u[i / 3][i % 3]);
-
-        let mut force = SVector::<f64, DOFS>::zeros();
-        let mut stiffness = SMatrix::<f64, DOFS, DOFS>::zeros();
         for g in 0..POINTS {
             let b = geo.bbar(g);
             // F = I + ∂u/∂X with the unmodified gradients (unused by small-strain
@@ -233,14 +247,34 @@ impl Element<DOFS> for Hex8 {
                 strain: b * ue,
                 deformation_gradient: f,
             };
-            let d = material
-                .update(&kin, &committed[g], &mut trial[g])
-                .map_err(|e| prefix(e, &format!("integration point {g}")))?;
+            let at_point = |e| prefix(e, &format!("integration point {g}"));
+            let d = if stiffness.is_some() {
+                Some(
+                    material
+                        .update(&kin, &committed[g], &mut trial[g])
+                        .map_err(at_point)?,
+                )
+            } else {
+                material
+                    .update_stress(&kin, &committed[g], &mut trial[g])
+                    .map_err(at_point)?;
+                None
+            };
             let dv = geo.dvol[g];
-            force += b.transpose() * (trial[g].stress * dv);
-            stiffness += b.transpose() * (d * b * dv);
+            let sdv = trial[g].stress * dv;
+            for (i, out) in force.iter_mut().enumerate() {
+                *out += (0..6).map(|v| b[(v, i)] * sdv[v]).sum::<f64>();
+            }
+            if let (Some(k), Some(d)) = (stiffness.as_deref_mut(), d) {
+                let db = d * b * dv;
+                for (j, col) in k.chunks_exact_mut(DOFS).enumerate() {
+                    for (i, out) in col.iter_mut().enumerate() {
+                        *out += (0..6).map(|v| b[(v, i)] * db[(v, j)]).sum::<f64>();
+                    }
+                }
+            }
         }
-        Ok(ElementResponse { force, stiffness })
+        Ok(())
     }
 
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>> {
@@ -248,6 +282,50 @@ impl Element<DOFS> for Hex8 {
             .dvol
             .to_vec())
     }
+}
+
+/// [`Element::evaluate`] through the element's own `evaluate_into`, into new matrices.
+pub(super) fn response_through_into(
+    element: &dyn Element<DOFS>,
+    ref_coords: &[Vec3],
+    u: &[Vec3],
+    committed: &[PointState],
+    trial: &mut [PointState],
+    material: &dyn Material,
+) -> Result<ElementResponse<DOFS>> {
+    let mut force = SVector::<f64, DOFS>::zeros();
+    let mut stiffness = SMatrix::<f64, DOFS, DOFS>::zeros();
+    element.evaluate_into(
+        ref_coords,
+        u,
+        committed,
+        trial,
+        material,
+        force.as_mut_slice(),
+        Some(stiffness.as_mut_slice()),
+    )?;
+    Ok(ElementResponse { force, stiffness })
+}
+
+/// The output buffers of [`Element::evaluate_into`], length-checked and zeroed.
+#[allow(clippy::type_complexity)]
+pub(super) fn cleared_outputs<'a>(
+    force: &'a mut [f64],
+    stiffness: Option<&'a mut [f64]>,
+) -> Result<(&'a mut [f64; DOFS], Option<&'a mut [f64; DOFS * DOFS]>)> {
+    check_len("force", force.len(), DOFS)?;
+    let force: &mut [f64; DOFS] = force.try_into().expect("length checked");
+    force.fill(0.0);
+    let stiffness = match stiffness {
+        Some(k) => {
+            check_len("stiffness", k.len(), DOFS * DOFS)?;
+            let k: &mut [f64; DOFS * DOFS] = k.try_into().expect("length checked");
+            k.fill(0.0);
+            Some(k)
+        }
+        None => None,
+    };
+    Ok((force, stiffness))
 }
 
 /// Nodal arrays and reference geometry for [`Element::evaluate`], after checking every
@@ -542,6 +620,54 @@ pub(super) mod tests {
         }
         let rel = worst / r.stiffness.abs().max();
         assert!(rel < 1e-6, "relative tangent error {rel:e}");
+    }
+
+    /// The direct kernel (`evaluate_into`) against the matrix form `Σ_g B̄ᵀσ dV`,
+    /// `Σ_g B̄ᵀ D B̄ dV` built from [`Hex8::strain_displacement`] and the material's own
+    /// update, for an elastoplastic material yielding at every point: force and tangent to
+    /// 1e-13 relative (only the order of the sums differs). A residual-only call gives the
+    /// same force and trial states bit for bit.
+    #[test]
+    fn direct_kernel_equals_the_matrix_form_and_residual_only_the_same_force() {
+        use crate::material::{ElastoPlastic, Hardening, Hill48};
+        let x = distorted_element();
+        let m = ElastoPlastic::new(
+            LinearElastic::new(70e3, 0.33).unwrap(),
+            Hill48::from_lankford(0.7, 1.3, 2.1).unwrap(),
+            Hardening::swift(500.0, 0.01, 0.22).unwrap(),
+        );
+        let mut rng = Lcg(11);
+        let u: Vec<Vec3> = (0..8).map(|_| rng.vec() * 0.03).collect();
+        let mut trial = states();
+        let r = Hex8.evaluate(&x, &u, &states(), &mut trial, &m).unwrap();
+        assert!(trial.iter().all(|t| t.eq_plastic_strain > 0.0), "must yield");
+        let (b, dv) = Hex8.strain_displacement(&x).unwrap();
+        let ue = SVector::<f64, DOFS>::from_fn(|i, _| u[i / 3][i % 3]);
+        let (mut force, mut stiffness) = (
+            SVector::<f64, DOFS>::zeros(),
+            SMatrix::<f64, DOFS, DOFS>::zeros(),
+        );
+        for g in 0..POINTS {
+            let mut point = PointState::default();
+            let d = m
+                .update(
+                    &Kinematics::from_strain(b[g] * ue),
+                    &PointState::default(),
+                    &mut point,
+                )
+                .unwrap();
+            assert_eq!(point.stress, trial[g].stress);
+            force += b[g].transpose() * point.stress * dv[g];
+            stiffness += b[g].transpose() * d * b[g] * dv[g];
+        }
+        assert!((r.force - force).amax() <= 1e-13 * force.amax());
+        assert!((r.stiffness - stiffness).amax() <= 1e-13 * stiffness.amax());
+        let mut residual_trial = states();
+        let mut residual = [0.0; DOFS];
+        Hex8.evaluate_into(&x, &u, &states(), &mut residual_trial, &m, &mut residual, None)
+            .unwrap();
+        assert_eq!(residual.as_slice(), r.force.as_slice());
+        assert_eq!(residual_trial, trial);
     }
 
     #[test]

@@ -68,9 +68,10 @@
 //! the `576` entries (against ~8k and four `24 x 24` temporaries in the plain
 //! `Gᵀ (𝔸 G)` form). The force is `f_a = r (w_a + q_a P̄:F)`.
 
-use nalgebra::{SMatrix, SVector};
-
-use super::hex8::{check_len, checked_inputs, jacobian, shape_derivatives, DOFS, NODES, POINTS};
+use super::hex8::{
+    checked_inputs, cleared_outputs, jacobian, response_through_into, shape_derivatives, DOFS,
+    NODES, POINTS,
+};
 use super::{prefix, Element, ElementResponse, Hex8};
 use crate::geometry::{Mat3, Vec3};
 use crate::material::{stress_to_tensor, Material, PointState, Tangent};
@@ -274,18 +275,7 @@ impl Element<DOFS> for Hex8FBar {
         trial: &mut [PointState],
         material: &dyn Material,
     ) -> Result<ElementResponse<DOFS>> {
-        let mut force = SVector::<f64, DOFS>::zeros();
-        let mut stiffness = SMatrix::<f64, DOFS, DOFS>::zeros();
-        self.evaluate_into(
-            ref_coords,
-            u,
-            committed,
-            trial,
-            material,
-            force.as_mut_slice(),
-            Some(stiffness.as_mut_slice()),
-        )?;
-        Ok(ElementResponse { force, stiffness })
+        response_through_into(self, ref_coords, u, committed, trial, material)
     }
 
     /// The kernel (module docs, "Kernel"): fixed-size stack arrays, the force and the
@@ -301,18 +291,7 @@ impl Element<DOFS> for Hex8FBar {
         force: &mut [f64],
         stiffness: Option<&mut [f64]>,
     ) -> Result<()> {
-        check_len("force", force.len(), DOFS)?;
-        let mut stiffness = match stiffness {
-            Some(k) => {
-                check_len("stiffness", k.len(), DOFS * DOFS)?;
-                let k: &mut [f64; DOFS * DOFS] = k.try_into().expect("length checked");
-                k.fill(0.0);
-                Some(k)
-            }
-            None => None,
-        };
-        let force: &mut [f64; DOFS] = force.try_into().expect("length checked");
-        force.fill(0.0);
+        let (force, mut stiffness) = cleared_outputs(force, stiffness)?;
         let (x, u, geo) = checked_inputs(ref_coords, u, committed, trial)?;
         let b0 = centre_gradients(&x)?;
         let h0 = displacement_gradient(&u, &b0);
@@ -342,10 +321,20 @@ impl Element<DOFS> for Hex8FBar {
             let fb = f * r;
             // F̄ - I = (r - 1) I + r H.
             let hb = Mat3::identity() * r_minus_one + h * r;
-            let resp = material
-                .update_finite_displacement_gradient(&hb, &committed[gp], &mut trial[gp])
-                .map_err(|e| prefix(e, &format!("integration point {gp}")))?;
-            let s = stress_to_tensor(&resp.pk2);
+            let at_point = |e| prefix(e, &format!("integration point {gp}"));
+            // Residual only: the material's stress part alone (the same stress, bit for bit).
+            let (pk2, c) = if stiffness.is_some() {
+                let resp = material
+                    .update_finite_displacement_gradient(&hb, &committed[gp], &mut trial[gp])
+                    .map_err(at_point)?;
+                (resp.pk2, resp.tangent)
+            } else {
+                let pk2 = material
+                    .update_finite_stress(&hb, &committed[gp], &mut trial[gp])
+                    .map_err(at_point)?;
+                (pk2, Tangent::zeros())
+            };
+            let s = stress_to_tensor(&pk2);
             let p = fb * s;
             let pf = p.component_mul(&f).sum();
             let w: [f64; DOFS] = std::array::from_fn(|i| (p * b[i / 3])[i % 3]);
@@ -358,7 +347,7 @@ impl Element<DOFS> for Hex8FBar {
                     fb: &fb,
                     f: &f,
                     s: &s,
-                    c: &resp.tangent,
+                    c: &c,
                     b,
                     g: &g,
                     g0: &g0,
@@ -398,6 +387,7 @@ impl Element<DOFS> for Hex8FBar {
 mod tests {
     use super::*;
     use crate::element::hex8::tests::{distorted_element, Lcg};
+    use nalgebra::SVector;
     use crate::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
 
     fn hill_swift() -> ElastoPlastic {

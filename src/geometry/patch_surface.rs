@@ -57,7 +57,14 @@ pub struct PatchSurface {
     /// Per patch, the trimmed face it belongs to (if any): a foot outside the trim is not a
     /// foot of that patch.
     trims: Vec<Option<PieceTrim>>,
+    /// The cold-start grid of every patch, `S(i/N, j/N)` at `[k][i (N + 1) + j]`, evaluated
+    /// once: a cold start then costs `(N + 1)^2` distances instead of as many patch
+    /// evaluations (the same points, so the same start, bit for bit).
+    cold_grid: Vec<[Vec3; COLD_GRID]>,
 }
+
+/// Points of the cold-start grid.
+const COLD_GRID: usize = (COLD_SAMPLES + 1) * (COLD_SAMPLES + 1);
 /// Which bounds of `[0, 1]^2` hold the foot: the strictly active constraints.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Kind {
@@ -130,7 +137,18 @@ impl PatchSurface {
             (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
             |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)),
         );
+        let n = COLD_SAMPLES as f64;
+        let cold_grid = patches
+            .iter()
+            .map(|p| {
+                std::array::from_fn(|ij| {
+                    let (i, j) = (ij / (COLD_SAMPLES + 1), ij % (COLD_SAMPLES + 1));
+                    p.point(i as f64 / n, j as f64 / n)
+                })
+            })
+            .collect();
         let mut surface = PatchSurface {
+            cold_grid,
             bvh: Bvh::new(&boxes),
             patches,
             boxes,
@@ -235,18 +253,23 @@ impl PatchSurface {
     /// Closest point on patch `k`, from `start` (warm) or from the best of a coarse grid.
     pub(crate) fn closest_on_patch(&self, k: usize, x: &Vec3, start: Option<(f64, f64)>) -> Local {
         let patch = &self.patches[k];
-        let dist2 = |u: f64, v: f64| (patch.point(u, v) - x).norm_squared();
         let (mut u, mut v) = match start {
             Some((u, v)) => (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0)),
             None => {
+                // The grid point nearest to x (the first of equals, in grid order).
                 let n = COLD_SAMPLES as f64;
-                let (_, u, v) = (0..=COLD_SAMPLES)
-                    .flat_map(|i| (0..=COLD_SAMPLES).map(move |j| (i as f64 / n, j as f64 / n)))
-                    .map(|(u, v)| (dist2(u, v), u, v))
-                    .fold(
-                        (f64::INFINITY, 0.5, 0.5),
-                        |b, c| if c.0 < b.0 { c } else { b },
-                    );
+                let (_, u, v) = self.cold_grid[k].iter().enumerate().fold(
+                    (f64::INFINITY, 0.5, 0.5),
+                    |b, (ij, p)| {
+                        let d = (p - x).norm_squared();
+                        if d < b.0 {
+                            let (i, j) = (ij / (COLD_SAMPLES + 1), ij % (COLD_SAMPLES + 1));
+                            (d, i as f64 / n, j as f64 / n)
+                        } else {
+                            b
+                        }
+                    },
+                );
                 (u, v)
             }
         };

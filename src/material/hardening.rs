@@ -162,6 +162,20 @@ impl Hardening {
         }
     }
 
+    /// `(σ_y, h)` at `ε̄p` in one call: the Swift law shares its power
+    /// (`h = n σ_y / (ε0 + ε̄p)`, equal to [`slope`](Self::slope) to round-off); the others
+    /// are the two functions.
+    pub fn yield_stress_and_slope(&self, eps_p: f64) -> (f64, f64) {
+        match self {
+            Hardening::Swift { c, eps0, n } => {
+                let x = eps0 + eps_p.max(0.0);
+                let sy = c * x.powf(*n);
+                (sy, n * sy / x)
+            }
+            _ => (self.yield_stress(eps_p), self.slope(eps_p)),
+        }
+    }
+
     /// Initial yield stress `σ_y(0)`.
     pub fn initial_yield_stress(&self) -> f64 {
         self.yield_stress(0.0)
@@ -231,6 +245,13 @@ mod tests {
         check_slope(&voce, &[1e-5, 0.05, 0.4]);
         check_slope(&lin, &[1e-5, 0.5]);
         check_slope(&tab, &[0.05, 0.2, 0.5]);
+        for law in [&swift, &voce, &lin, &tab] {
+            for e in [0.0, 1e-5, 0.05, 0.2, 0.5] {
+                let (sy, h) = law.yield_stress_and_slope(e);
+                assert_eq!(sy, law.yield_stress(e), "{law:?} at {e}");
+                assert!((h - law.slope(e)).abs() <= 1e-14 * h.abs(), "{law:?} at {e}");
+            }
+        }
     }
 
     #[test]

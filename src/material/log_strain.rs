@@ -66,8 +66,7 @@
 //! (`𝒫 = 2 ∂E/∂C`, `ℒ = T : 4 ∂²E/∂C∂C` of Miehe et al.), `D = ∂T/∂E` the small-strain
 //! algorithmic tangent. Every entry is checked against finite differences in the tests.
 
-use nalgebra::SymmetricEigen;
-
+use super::sym_eigen3::sym_eigen3;
 use super::{
     strain_from_tensor, strain_to_tensor, stress_from_tensor, stress_to_tensor, FiniteResponse,
     Kinematics, Material, PointState, Tangent, Voigt,
@@ -113,15 +112,13 @@ impl LogStrain {
             )));
         }
         let sym = (a + a.transpose()) * 0.5;
-        let eig = SymmetricEigen::new(sym);
-        let mu = [eig.eigenvalues[0], eig.eigenvalues[1], eig.eigenvalues[2]];
+        let (mu, q) = sym_eigen3(&sym);
         let lambda = mu.map(|m| 1.0 + m);
         if mu.iter().any(|&m| m.is_nan() || m <= -1.0) {
             return Err(Error::NoConvergence(format!(
                 "right Cauchy-Green tensor with eigenvalues {lambda:?} (inverted material)"
             )));
         }
-        let q = eig.eigenvectors;
         let f1 = std::array::from_fn(|i| std::array::from_fn(|j| first(lambda[i], lambda[j])));
         // f[a, b, c] is symmetric (`second` sorts its arguments, so bit for bit): the ten
         // index multisets, each computed once.
@@ -241,6 +238,34 @@ pub fn lagrangian_update<M: Material + ?Sized>(
     committed: &PointState,
     trial: &mut PointState,
 ) -> Result<FiniteResponse> {
+    let (f, j, ls, kin) = log_kinematics(h)?;
+    let d = material.update(&kin, &log_space(committed), trial)?;
+    let t = trial.stress;
+    let p = ls.projection();
+    let pk2 = p.transpose() * t;
+    let tangent = p.transpose() * d * p + ls.curvature(&t);
+    finish(trial, &f, j, &pk2);
+    Ok(FiniteResponse { pk2, tangent })
+}
+
+/// The stress part of [`lagrangian_update`] (the same `trial` and `S`, bit for bit),
+/// through [`Material::update_stress`]: no `ℒ(T)`, no `𝒫ᵀ D 𝒫`, no material tangent.
+pub fn lagrangian_stress<M: Material + ?Sized>(
+    material: &M,
+    h: &Mat3,
+    committed: &PointState,
+    trial: &mut PointState,
+) -> Result<Voigt> {
+    let (f, j, ls, kin) = log_kinematics(h)?;
+    material.update_stress(&kin, &log_space(committed), trial)?;
+    let pk2 = ls.projection().transpose() * trial.stress;
+    finish(trial, &f, j, &pk2);
+    Ok(pk2)
+}
+
+/// `F = I + h`, `det F` (checked positive), the log strain and the kinematics it gives the
+/// small-strain model.
+fn log_kinematics(h: &Mat3) -> Result<(Mat3, f64, LogStrain, Kinematics)> {
     let f = Mat3::identity() + h;
     let j = f.determinant();
     if j <= 0.0 || !j.is_finite() {
@@ -253,18 +278,21 @@ pub fn lagrangian_update<M: Material + ?Sized>(
         strain: ls.strain(),
         deformation_gradient: f,
     };
-    let log_committed = PointState {
+    Ok((f, j, ls, kin))
+}
+
+/// The committed state as the small-strain model sees it: the log-space stress.
+fn log_space(committed: &PointState) -> PointState {
+    PointState {
         stress: committed.log_stress,
         ..*committed
-    };
-    let d = material.update(&kin, &log_committed, trial)?;
-    let t = trial.stress;
-    let p = ls.projection();
-    let pk2 = p.transpose() * t;
-    let tangent = p.transpose() * d * p + ls.curvature(&t);
-    trial.log_stress = t;
-    trial.stress = stress_from_tensor(&(f * stress_to_tensor(&pk2) * f.transpose() / j));
-    Ok(FiniteResponse { pk2, tangent })
+    }
+}
+
+/// `T` into `trial.log_stress`, Cauchy `σ = F S Fᵀ / J` into `trial.stress`.
+fn finish(trial: &mut PointState, f: &Mat3, j: f64, pk2: &Voigt) {
+    trial.log_stress = trial.stress;
+    trial.stress = stress_from_tensor(&(f * stress_to_tensor(pk2) * f.transpose() / j));
 }
 
 /// `f[a, b]` for `f = ½ ln`, stable for `a ≈ b`.
@@ -297,6 +325,7 @@ fn second_taylor(a: f64, b: f64, c: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::SymmetricEigen;
 
     fn c_of(f: &Mat3) -> Mat3 {
         f.transpose() * f

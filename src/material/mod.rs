@@ -36,6 +36,8 @@ mod hardening;
 mod hill48;
 mod linear_elastic;
 pub mod log_strain;
+mod spectral_return;
+mod sym_eigen3;
 
 pub use elastoplastic::ElastoPlastic;
 pub use hardening::Hardening;
@@ -171,6 +173,19 @@ pub trait Material: std::fmt::Debug + Send + Sync {
         trial: &mut PointState,
     ) -> Result<Tangent>;
 
+    /// The trial state of [`update`](Self::update) without its tangent, for a
+    /// residual-only evaluation (a line-search trial): the same `trial`, bit for bit.
+    /// The default drops the tangent of `update`; a model whose tangent costs work of its
+    /// own (a return mapping) skips it.
+    fn update_stress(
+        &self,
+        kin: &Kinematics,
+        committed: &PointState,
+        trial: &mut PointState,
+    ) -> Result<()> {
+        self.update(kin, committed, trial).map(|_| ())
+    }
+
     /// Finite-strain update at the deformation gradient `f` (an F-bar element passes its
     /// modified gradient): returns the second Piola-Kirchhoff stress and `∂S/∂E_GL`, and
     /// writes the Cauchy stress into `trial.stress`, the log-space stress into
@@ -202,6 +217,21 @@ pub trait Material: std::fmt::Debug + Send + Sync {
         trial: &mut PointState,
     ) -> Result<FiniteResponse> {
         log_strain::lagrangian_update(self, h, committed, trial)
+    }
+
+    /// The second Piola-Kirchhoff stress and `trial` of
+    /// [`update_finite_displacement_gradient`](Self::update_finite_displacement_gradient)
+    /// without the tangent (bit for bit the same), for a residual-only evaluation. The
+    /// default is the log-strain extension's stress part
+    /// ([`log_strain::lagrangian_stress`]); a material that overrides the update overrides
+    /// this too.
+    fn update_finite_stress(
+        &self,
+        h: &Mat3,
+        committed: &PointState,
+        trial: &mut PointState,
+    ) -> Result<Voigt> {
+        log_strain::lagrangian_stress(self, h, committed, trial)
     }
 
     /// The elastic tangent (initial stiffness), e.g. for a first predictor or a

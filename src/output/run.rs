@@ -471,6 +471,10 @@ impl RunOutput {
                 "contact": sim.phase_times.contact,
                 "factorization_and_solve": sim.phase_times.factorization_and_solve,
             },
+            "evaluations": {
+                "full": sim.phase_times.full_evaluations,
+                "residual_only": sim.phase_times.residual_evaluations,
+            },
             "kinematics": settings.kinematics.name(),
             "nodes": sim.model.mesh.nodes.len(),
             "elements": sim.model.mesh.hexes.len(),

@@ -229,12 +229,28 @@ fn evaluate_elements(
     Ok(buffers)
 }
 
-/// Wall time spent in each phase of assembly (seconds), accumulated.
+/// Wall time spent in each phase of assembly (seconds), and the evaluations made,
+/// accumulated.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PhaseTimes {
     pub elements: f64,
     pub contact: f64,
     pub factorization_and_solve: f64,
+    /// Evaluations with element tangents and assembly ([`IncrementContext::evaluate`]).
+    pub full_evaluations: usize,
+    /// Residual-only evaluations ([`IncrementContext::evaluate_residual`]).
+    pub residual_evaluations: usize,
+}
+
+impl PhaseTimes {
+    /// Adds `other`'s times and counts.
+    pub fn add(&mut self, other: &PhaseTimes) {
+        self.elements += other.elements;
+        self.contact += other.contact;
+        self.factorization_and_solve += other.factorization_and_solve;
+        self.full_evaluations += other.full_evaluations;
+        self.residual_evaluations += other.residual_evaluations;
+    }
 }
 
 /// Frozen contact frame of a pair (foot point and normal in the tool's frame at the start of
@@ -322,6 +338,11 @@ impl IncrementContext<'_> {
         };
         let mut trial_points = self.committed_points.to_vec();
 
+        if with_jacobian {
+            times.full_evaluations += 1;
+        } else {
+            times.residual_evaluations += 1;
+        }
         let t0 = Instant::now();
         let threads = element_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);

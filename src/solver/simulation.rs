@@ -483,9 +483,7 @@ impl Simulation {
             let state = self.saved_state();
             self.saved.push_back(state);
         }
-        self.phase_times.elements += trial.times.elements;
-        self.phase_times.contact += trial.times.contact;
-        self.phase_times.factorization_and_solve += trial.times.factorization_and_solve;
+        self.phase_times.add(&trial.times);
         let mut report = self.commit(
             t_new,
             trial.x,
