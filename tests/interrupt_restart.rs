@@ -83,6 +83,11 @@ fn last_frame_displacements(dir: &Path) -> Vec<f64> {
         .expect("frames")
         .flatten()
         .map(|e| e.path())
+        // The blank's frames (frame_NNNN.vtu), not the tools' (frame_NNNN_<tool>.vtu).
+        .filter(|p| {
+            let name = p.file_name().unwrap_or_default().to_string_lossy();
+            name.starts_with("frame_") && name.len() == "frame_0000.vtu".len()
+        })
         .filter(|p| p.extension().is_some_and(|x| x == "vtu"))
         .collect();
     names.sort();

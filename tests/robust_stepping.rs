@@ -115,6 +115,11 @@ fn last_frame(dir: &Path) -> PathBuf {
     let mut frames: Vec<PathBuf> = std::fs::read_dir(dir.join("frames"))
         .unwrap()
         .map(|e| e.unwrap().path())
+        // The blank's frames (frame_NNNN.vtu), not the tools' (frame_NNNN_<tool>.vtu).
+        .filter(|p| {
+            let name = p.file_name().unwrap_or_default().to_string_lossy();
+            name.starts_with("frame_") && name.len() == "frame_0000.vtu".len()
+        })
         .collect();
     frames.sort();
     frames.pop().unwrap()
