@@ -288,11 +288,16 @@ fn rigid_rotation_of_a_plastic_element_is_objective() {
 /// asymptotic range (the first iterate of an elastoplastic increment starts from the
 /// elastic predictor, relative residual ~0.3, and points at the plastic front switch
 /// between elastic and plastic in the first iterations), where a three-point estimate
-/// mixes the two regimes. In that window every step must be quadratic with a bounded
-/// constant, `r⁺ <= 200 r²` (a linearly converging Newton, `r⁺ = c r`, breaks any such bound
-/// as `r -> 0`: at r = 1e-8 it needs c < 2e-6), the last observed order of every increment
-/// must be >= 1.6 and their median >= 1.9. Measured: largest constant 175, median order
-/// 2.12 over 19 increments, worst 1.65 (increment 30, residuals 4.4e-3, 3.6e-5, 1.3e-8 with
+/// mixes the two regimes. In that window the last observed order of every increment must be
+/// >= 1.6 and their median >= 1.9, and where Newton's local model holds (|R| <= 1e-4) every
+/// step must be quadratic with a bounded constant, `r⁺ <= 20 r²` (a linearly converging
+/// Newton, `r⁺ = c r`, breaks any such bound as `r -> 0`: at r = 1e-8 it needs c < 2e-7).
+/// Between 1e-4 and 1e-2 a step may still cross a point's yield or unloading switch and
+/// contract only linearly (with the scalar return map: increments 35-36, 3.9e-4 -> 1.9e-5,
+/// constant 125-281), which says nothing of the tangent. Measured with the scalar return map
+/// (issue 13): largest constant below 1e-4 2.4, worst order 1.94, median 3.39 over 21
+/// increments. Earlier measurement, with the 7 x 7 return map: worst 1.65 (increment 30,
+/// residuals 4.4e-3, 3.6e-5, 1.3e-8 with
 /// constants 1.9 and 10, contact statuses and the set of plastic points unchanged over these
 /// iterations: a quadratic step whose constant grows while the plastic zone settles; the
 /// three-point estimate reads such a step as a lower order). The worst order depends on
@@ -365,7 +370,10 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
             worst = worst.min(last);
             last_orders.push(last);
         }
-        for w in res.windows(2).filter(|w| w[1] > 1e-10) {
+        // The quadratic constant is read where Newton's local model holds (|R| <= 1e-4);
+        // above it a step may cross a point's yield or unloading switch and contract only
+        // linearly (increments 35-36: 3.9e-4 -> 1.9e-5), which says nothing of the tangent.
+        for w in res.windows(2).filter(|w| w[0] <= 1e-4 && w[1] > 1e-10) {
             quadratic_constant = quadratic_constant.max(w[1] / (w[0] * w[0]));
         }
     }
@@ -394,7 +402,7 @@ fn newton_is_quadratic_on_a_plastic_strip_bent_over_a_cylinder() {
         "{measured} increments with a measured order"
     );
     assert!(
-        quadratic_constant <= 200.0,
+        quadratic_constant <= 20.0,
         "r+/r^2 up to {quadratic_constant}"
     );
     assert!(worst >= 1.6, "observed order {worst}");
