@@ -38,6 +38,9 @@ pub struct SimState {
     checkpoint_due: Option<String>,
     /// Increment count of the state last saved as checkpoints/final.json.
     final_saved: Option<usize>,
+    /// The progress bar of a running `sim.run()`: warnings are printed with the bar cleared
+    /// and drawn again under them, so the bar's line is not repeated above every warning.
+    progress: Option<indicatif::ProgressBar>,
 }
 
 type NodeSnapshot = (usize, f64, Vec<Vec<[f64; 3]>>);
@@ -462,11 +465,15 @@ impl SimState {
         let sim = self.sim.as_ref().expect("started");
         if self.host.warnings {
             for w in &report.warnings {
-                eprintln!(
+                let line = format!(
                     "warning: increment {} (t = {}): {w}",
                     report.index,
                     fmt(report.time)
                 );
+                match &self.progress {
+                    Some(bar) => bar.suspend(|| eprintln!("{line}")),
+                    None => eprintln!("{line}"),
+                }
             }
         }
         if let Some(out) = self.output.as_mut() {
@@ -936,6 +943,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 kept: serde_json::Map::new(),
                 checkpoint_due: None,
                 final_saved: None,
+                progress: None,
             }));
             h.simulations.add(sim.clone());
             Ok(sim)
@@ -1062,12 +1070,13 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 let b = indicatif::ProgressBar::new(1000);
                 b.set_style(
                     indicatif::ProgressStyle::with_template(
-                        "{bar:40} {percent:>3}% of the time  {msg}  [{elapsed_precise}]",
+                        "{bar:40} {percent:>3}% of the time  {msg}  [{elapsed_precise}, ETA {eta}]",
                     )
                     .expect("valid template"),
                 );
                 b
             });
+            st.progress = bar.clone();
             let mut last = None;
             drop(st);
             while !s.borrow().sim.as_ref().expect("started").is_finished() {
@@ -1077,6 +1086,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                         if let Some(b) = &bar {
                             b.abandon_with_message("stopped");
                         }
+                        s.borrow_mut().progress = None;
                         return Err(e);
                     }
                 };
@@ -1093,6 +1103,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 b.finish();
             }
             let mut st = s.borrow_mut();
+            st.progress = None;
             st.finish()?;
             let names = tool_names(&st);
             Ok(last.map(|r| report_map(&r, &names)).unwrap_or_default())

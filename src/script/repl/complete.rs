@@ -186,7 +186,7 @@ mod tests {
     fn free_functions_variables_settings_tools_and_commands() {
         let (start, c) = complete("let m = bloc");
         assert_eq!((start, c), (8, vec!["block".to_string(), "block_lines".to_string()]));
-        assert_eq!(complete("si").1, ["sim", "simulation"]);
+        assert_eq!(complete("si").1, ["sig", "sim", "simulation"]);
         assert_eq!(
             complete("sim.settings(#{ step_control: \"adaptive\", max_sl").1,
             ["max_slip_increment"]
