@@ -43,8 +43,16 @@ fn options() -> Result<Options, String> {
     while let Some(a) = args.next() {
         let mut value = |name: &str| args.next().ok_or(format!("{name} needs a value"));
         match a.as_str() {
-            "--solves" => o.solves = value("--solves")?.parse().map_err(|e| format!("--solves: {e}"))?,
-            "--repeats" => o.repeats = value("--repeats")?.parse().map_err(|e| format!("--repeats: {e}"))?,
+            "--solves" => {
+                o.solves = value("--solves")?
+                    .parse()
+                    .map_err(|e| format!("--solves: {e}"))?
+            }
+            "--repeats" => {
+                o.repeats = value("--repeats")?
+                    .parse()
+                    .map_err(|e| format!("--repeats: {e}"))?
+            }
             "--dumps" => o.dumps = value("--dumps")?.into(),
             "--tribo" => o.tribo = value("--tribo")?.into(),
             "--fresh" => o.fresh = true,
@@ -53,7 +61,8 @@ fn options() -> Result<Options, String> {
                     .split_once('x')
                     .and_then(|(c, l)| Some((c.parse().ok()?, l.parse().ok()?)))
                     .filter(|&(c, l): &(usize, usize)| c > 0 && l > 0);
-                o.sizes.push(parsed.ok_or(format!("size '{size}' is not CELLSxLAYERS (e.g. 50x2)"))?);
+                o.sizes
+                    .push(parsed.ok_or(format!("size '{size}' is not CELLSxLAYERS (e.g. 50x2)"))?);
             }
         }
     }
@@ -115,7 +124,18 @@ fn main() {
     });
     println!(
         "{:>9} {:>7} {:>8} {:>9} {:>8} {:>9} {:>8} {:>8} {:>9} {:>8} {:>7} {:>7}",
-        "mesh", "n", "nnz(A)", "L+U", "fact ms", "+solve ms", "floor L", "floor ms", "fact/floor", "backward", "run MiB", "bench MiB"
+        "mesh",
+        "n",
+        "nnz(A)",
+        "L+U",
+        "fact ms",
+        "+solve ms",
+        "floor L",
+        "floor ms",
+        "fact/floor",
+        "backward",
+        "run MiB",
+        "bench MiB"
     );
     let mut points = Vec::new();
     let mut ratios = Vec::new();

@@ -167,7 +167,10 @@ fn baseline_runs_its_own_script_with_the_settings_it_declares() {
         let full = summary["evaluations"]["full"].as_f64().unwrap();
         // At least one full evaluation per Newton iteration (each step solves with one).
         assert!(full >= it, "{summary}");
-        assert_eq!(m["full_evaluations_per_iteration"].as_f64().unwrap(), full / it);
+        assert_eq!(
+            m["full_evaluations_per_iteration"].as_f64().unwrap(),
+            full / it
+        );
         assert_eq!(
             m["residual_evaluations_per_iteration"].as_f64().unwrap(),
             summary["evaluations"]["residual_only"].as_f64().unwrap() / it

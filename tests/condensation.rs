@@ -3,8 +3,8 @@
 
 mod common;
 
-use tribo::solver::linear::{FaerLu, LinearSolverKind, SymmetricLu};
 use tribo::contact::ContactStatus;
+use tribo::solver::linear::{FaerLu, LinearSolverKind, SymmetricLu};
 use tribo::solver::Simulation;
 
 fn drag(eliminate: bool) -> Simulation {
@@ -152,7 +152,10 @@ fn runs_agree(mut a: Simulation, mut b: Simulation) {
         .zip(b.unknowns())
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     let iters = |s: &Simulation| s.history.iter().map(|r| r.iterations).collect::<Vec<_>>();
-    println!("max difference {d:.2e} of {scale:.2e}; iterations {:?}", iters(&a));
+    println!(
+        "max difference {d:.2e} of {scale:.2e}; iterations {:?}",
+        iters(&a)
+    );
     assert_eq!(iters(&a), iters(&b));
     assert!(d < 1e-9 * scale, "runs differ by {d}");
 }
@@ -185,7 +188,11 @@ fn two_roller_drag(eliminate: bool) -> Simulation {
 fn two_pair_nodes_condense_to_the_mixed_step() {
     let mut sim = two_roller_drag(true);
     let n_lambda = sim.unknowns().len() - 3 * (33 * 2 * 9);
-    assert_eq!(sim.eliminated_multipliers(), n_lambda, "displacement-only system");
+    assert_eq!(
+        sim.eliminated_multipliers(),
+        n_lambda,
+        "displacement-only system"
+    );
     let mut worst = 0.0f64;
     let mut active_per_tool = [0usize; 2];
     for steps in [2, 3, 3] {
@@ -213,9 +220,16 @@ fn two_pair_nodes_condense_to_the_mixed_step() {
         }
     }
     // Each roller's pair is the active one at some nodes (and in gap at the others).
-    assert!(active_per_tool.iter().all(|&c| c > 0), "{active_per_tool:?}");
+    assert!(
+        active_per_tool.iter().all(|&c| c > 0),
+        "{active_per_tool:?}"
+    );
     let condenser = sim.condenser().unwrap();
-    assert_eq!(condenser.fallback_count(), 0, "no node had two active pairs");
+    assert_eq!(
+        condenser.fallback_count(),
+        0,
+        "no node had two active pairs"
+    );
     println!("worst relative difference {worst:.2e}");
 }
 

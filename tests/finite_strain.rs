@@ -288,8 +288,8 @@ fn rigid_rotation_of_a_plastic_element_is_objective() {
 /// asymptotic range (the first iterate of an elastoplastic increment starts from the
 /// elastic predictor, relative residual ~0.3, and points at the plastic front switch
 /// between elastic and plastic in the first iterations), where a three-point estimate
-/// mixes the two regimes. In that window the last observed order of every increment must be
-/// >= 1.6 and their median >= 1.9, and where Newton's local model holds (|R| <= 1e-4) every
+/// mixes the two regimes. In that window the last observed order of every increment must
+/// be at least 1.6 and their median at least 1.9, and where Newton's local model holds (|R| <= 1e-4) every
 /// step must be quadratic with a bounded constant, `r⁺ <= 20 r²` (a linearly converging
 /// Newton, `r⁺ = c r`, breaks any such bound as `r -> 0`: at r = 1e-8 it needs c < 2e-7).
 /// Between 1e-4 and 1e-2 a step may still cross a point's yield or unloading switch and

@@ -162,7 +162,12 @@ fn a_signal_stops_the_cup_and_restart_reproduces_the_uninterrupted_run() {
         let restarted = summary(&dir);
         let mut a = reference.as_object().unwrap().clone();
         let mut b = restarted.as_object().unwrap().clone();
-        for volatile in ["wall_time_s", "phase_times_s", "evaluations", "symbolic_analyses"] {
+        for volatile in [
+            "wall_time_s",
+            "phase_times_s",
+            "evaluations",
+            "symbolic_analyses",
+        ] {
             a.remove(volatile);
             b.remove(volatile);
         }

@@ -161,10 +161,7 @@ fn frames_show_the_deformed_blank_and_the_tools_at_their_pose() {
     }
     assert!(moved > 1e-3, "the blank deforms: largest |u| {moved}");
     // At t = 0 the punch is the patch itself: its corner (-1, -1, 1.02).
-    assert!(punch0
-        .points
-        .iter()
-        .any(|p| p == &[-1.0, -1.0, 1.02]));
+    assert!(punch0.points.iter().any(|p| p == &[-1.0, -1.0, 1.02]));
 
     // Contact vectors of the last increment: |tangential_force| = lambda_t_norm, and the
     // slip the sideways punch drags the top face through.
@@ -188,8 +185,7 @@ fn frames_show_the_deformed_blank_and_the_tools_at_their_pose() {
     assert!(slipping > 0, "the punch drags the top face: {status:?}");
 
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["frames"], 5);
     assert_eq!(summary["frame_points"], "current");
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
@@ -204,7 +200,10 @@ fn reference_points_on_request() {
     let first = read_vtu(&out.join("frames/frame_0000.vtu")).unwrap();
     let last = read_vtu(&out.join("frames/frame_0002.vtu")).unwrap();
     assert_eq!(first.points, last.points);
-    assert!(field(&last, "displacement").values.iter().any(|u| u.abs() > 1e-3));
+    assert!(field(&last, "displacement")
+        .values
+        .iter()
+        .any(|u| u.abs() > 1e-3));
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 
@@ -214,18 +213,31 @@ fn frames_follow_the_interval_not_the_increments() {
     let out = run("default", &scene("increments: 30", "sim.run();"));
     let t = times(&pvd_entries(&out.join("frames.pvd")));
     assert_eq!(t.len(), 21, "{t:?}");
-    assert!((t[20] - 1.0).abs() < 1e-12, "the end time is the last frame: {t:?}");
+    assert!(
+        (t[20] - 1.0).abs() < 1e-12,
+        "the end time is the last frame: {t:?}"
+    );
     // One frame per interval [0.05 k, 0.05 (k + 1)): the first increment past each multiple.
     let slot = |t: f64| (t / 0.05 + 1e-9).floor() as i64;
     for (k, &time) in t.iter().enumerate() {
         assert_eq!(slot(time), k as i64, "{t:?}");
     }
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
-    assert_eq!(history.lines().count(), 1 + 30, "history keeps every increment");
+    assert_eq!(
+        history.lines().count(),
+        1 + 30,
+        "history keeps every increment"
+    );
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 
-    let out = run("interval", &scene("increments: 8, output_interval: 0.5", "sim.run();"));
-    assert_eq!(times(&pvd_entries(&out.join("frames.pvd"))), vec![0.0, 0.5, 1.0]);
+    let out = run(
+        "interval",
+        &scene("increments: 8, output_interval: 0.5", "sim.run();"),
+    );
+    assert_eq!(
+        times(&pvd_entries(&out.join("frames.pvd"))),
+        vec![0.0, 0.5, 1.0]
+    );
     assert!(!out.join("frames/frame_0003.vtu").exists());
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
@@ -285,8 +297,7 @@ fn history_names_units_and_the_model_fraction() {
     assert!(rows.iter().all(|r| r[fraction] == 0.25));
     assert_eq!(rows[1][time], 1.0);
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["model_fraction"], 0.25);
     assert_eq!(summary["units"]["force"], "N");
     let _ = std::fs::remove_dir_all(out.parent().unwrap());

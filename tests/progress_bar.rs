@@ -20,7 +20,11 @@ fn warnings_do_not_repeat_the_progress_line_and_the_bar_has_an_eta() {
     let tail = "sim.settings(#{ step_control: \"adaptive\", max_slip_increment: 1e-4, \
                 dt_min: 0.1, dt_initial: 0.1 });\nsim.run();";
     std::fs::write(&script, common::pty::drag_scene(16, 30, 0, tail)).unwrap();
-    let command = format!("{BIN} run {} --out {}", script.display(), dir.join("out").display());
+    let command = format!(
+        "{BIN} run {} --out {}",
+        script.display(),
+        dir.join("out").display()
+    );
     let out = Command::new("script")
         .args(["-q", "-e", "-c", &command, "/dev/null"])
         .env("TERM", "xterm")
@@ -28,9 +32,15 @@ fn warnings_do_not_repeat_the_progress_line_and_the_bar_has_an_eta() {
         .expect("util-linux `script` runs tribo in a pseudo-terminal");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "the run finishes:\n{text}");
-    let warnings: Vec<usize> = text.match_indices("warning: increment").map(|(i, _)| i).collect();
+    let warnings: Vec<usize> = text
+        .match_indices("warning: increment")
+        .map(|(i, _)| i)
+        .collect();
     assert!(warnings.len() >= 5, "every increment warns:\n{text}");
-    assert!(text.contains("of the time"), "the bar is drawn on a terminal:\n{text}");
+    assert!(
+        text.contains("of the time"),
+        "the bar is drawn on a terminal:\n{text}"
+    );
     assert!(text.contains("ETA"), "the bar shows the time left:\n{text}");
     for &at in &warnings {
         // What the terminal shows on the warning's line before it: the text after the last

@@ -132,7 +132,10 @@ fn runnable(line: &str, out: &Path) -> Result<Vec<String>, &'static str> {
     }
     if args.get(1).is_some_and(|s| s.ends_with("square_cup.rhai")) {
         args.retain(|a| !a.starts_with("cells=") && !a.starts_with("travel="));
-        while let Some(i) = args.windows(2).position(|w| w[0] == "--set" && w[1] == "--set") {
+        while let Some(i) = args
+            .windows(2)
+            .position(|w| w[0] == "--set" && w[1] == "--set")
+        {
             args.remove(i);
         }
         if args.last().is_some_and(|a| a == "--set") {
@@ -267,8 +270,15 @@ fn tour_script_runs_and_its_mu_is_the_friction_coefficient() {
     // Sliding under the whole contact zone, the tool's force ratio is mu up to the tilt of
     // the contact normals under the cylinder: within 2 % (measured 0.8 %).
     for (set, mu) in [(None, 0.2), (Some("mu=0.3"), 0.3)] {
-        let mut args = vec!["run".to_string(), script.display().to_string(), "--quiet".into()];
-        args.extend(["--out".into(), dir.join(format!("out{mu}")).display().to_string()]);
+        let mut args = vec![
+            "run".to_string(),
+            script.display().to_string(),
+            "--quiet".into(),
+        ];
+        args.extend([
+            "--out".into(),
+            dir.join(format!("out{mu}")).display().to_string(),
+        ]);
         if let Some(s) = set {
             args.extend(["--set".into(), s.into()]);
         }
@@ -304,15 +314,15 @@ fn same_output_line(expected: &str, actual: &str) -> bool {
     }
     let (a, b) = (tokens(expected), tokens(actual));
     a.len() == b.len()
-        && a.iter().zip(&b).all(|(x, y)| {
-            match (x.parse::<f64>(), y.parse::<f64>()) {
+        && a.iter()
+            .zip(&b)
+            .all(|(x, y)| match (x.parse::<f64>(), y.parse::<f64>()) {
                 (Ok(u), Ok(v)) if x.contains(['.', 'e']) || y.contains(['.', 'e']) => {
                     (u.abs() < 1e-9 && v.abs() < 1e-9)
                         || (u - v).abs() <= 1e-4 * u.abs().max(v.abs())
                 }
                 _ => x == y,
-            }
-        })
+            })
 }
 
 #[test]
@@ -325,7 +335,10 @@ fn repl_transcript_is_what_the_repl_prints() {
     let command = lines.next().unwrap().strip_prefix("$ tribo ").unwrap();
     let (mut input, mut expected) = (String::new(), Vec::new());
     for line in lines {
-        match line.strip_prefix("tribo> ").or_else(|| line.strip_prefix("  ...> ")) {
+        match line
+            .strip_prefix("tribo> ")
+            .or_else(|| line.strip_prefix("  ...> "))
+        {
             Some(typed) => {
                 input.push_str(typed);
                 input.push('\n');
@@ -356,11 +369,23 @@ fn repl_transcript_is_what_the_repl_prints() {
 
 #[test]
 fn number_comparison_of_transcripts() {
-    assert!(same_output_line("t = 0.1 (dt 0.1), [-0.0225488, 1.74793]", "t = 0.1 (dt 0.1), [-0.0225489, 1.74793]"));
-    assert!(same_output_line("residuals 1.5268e-15 (force)", "residuals 3.1e-16 (force)"));
-    assert!(!same_output_line("residuals 1.5e-5 (force)", "residuals 3.1e-16 (force)"));
+    assert!(same_output_line(
+        "t = 0.1 (dt 0.1), [-0.0225488, 1.74793]",
+        "t = 0.1 (dt 0.1), [-0.0225489, 1.74793]"
+    ));
+    assert!(same_output_line(
+        "residuals 1.5268e-15 (force)",
+        "residuals 3.1e-16 (force)"
+    ));
+    assert!(!same_output_line(
+        "residuals 1.5e-5 (force)",
+        "residuals 3.1e-16 (force)"
+    ));
     assert!(!same_output_line("2 iterations", "3 iterations"));
-    assert!(!same_output_line("[-0.0225488, 1.74793]", "[-0.0225488, 1.75793]"));
+    assert!(!same_output_line(
+        "[-0.0225488, 1.74793]",
+        "[-0.0225488, 1.75793]"
+    ));
     assert!(!same_output_line("increment 1: x", "increment 1: y"));
 }
 
@@ -385,17 +410,27 @@ fn shown_sweep_table_is_the_committed_one_and_cited_files_exist() {
             && !word.contains('*')
             && !word.contains("NAME");
         if looks_like_file {
-            assert!(root().join(word).exists(), "README cites {word}, which does not exist");
+            assert!(
+                root().join(word).exists(),
+                "README cites {word}, which does not exist"
+            );
             cited += 1;
         }
     }
     assert!(cited >= 30, "only {cited} files cited");
-    assert!(!text.contains("DESIGN.md"), "README points to a page outside the repository");
+    assert!(
+        !text.contains("DESIGN.md"),
+        "README points to a page outside the repository"
+    );
     for dir in ["docs", "std-lib"] {
         for entry in std::fs::read_dir(root().join(dir)).unwrap() {
             let path = entry.unwrap().path();
             if let Ok(body) = std::fs::read_to_string(&path) {
-                assert!(!body.contains("shared/reference"), "{} cites shared/reference", path.display());
+                assert!(
+                    !body.contains("shared/reference"),
+                    "{} cites shared/reference",
+                    path.display()
+                );
             }
         }
     }

@@ -43,14 +43,20 @@ fn completion_multi_line_input_and_help_in_a_terminal() {
     // One function's help: the engine's signature and the reference's row.
     s.send(b":help tool_force\r");
     let at = s.expect(at, "tool_force(Simulation, string) -> array");
-    let at = s.expect(at, "sim.tool_force(name): total force the body exerts on the tool");
+    let at = s.expect(
+        at,
+        "sim.tool_force(name): total force the body exerts on the tool",
+    );
 
     s.send(b":foo\r");
     let at = s.expect(at, "unknown command ':foo'");
 
     // One step: its summary line, not the report map.
     s.send(b"sim.step()\r");
-    let at = s.expect(at, "increment 1: t = 0.1 (dt 0.1), roller at [0.0, 0.0, -0.012]");
+    let at = s.expect(
+        at,
+        "increment 1: t = 0.1 (dt 0.1), roller at [0.0, 0.0, -0.012]",
+    );
     let end = s.expect(at, "active nodes");
     assert!(!s.text(at, end).contains("#{"), "the report map was echoed");
     s.quit();

@@ -51,7 +51,9 @@ fn bend(kind: ElementKind, layers: usize, elastic: bool) -> Curve {
         [1, 1, layers],
     )
     .unwrap();
-    let levels: Vec<f64> = (0..=layers).map(|k| -T / 2.0 + T * k as f64 / layers as f64).collect();
+    let levels: Vec<f64> = (0..=layers)
+        .map(|k| -T / 2.0 + T * k as f64 / layers as f64)
+        .collect();
     for (k, z) in levels.iter().enumerate() {
         let set = mesh.select_nodes(|p| (p.x - SLICE).abs() < 1e-12 && (p.z - z).abs() < 1e-9);
         mesh.add_node_set(&format!("end{k}"), set).unwrap();
@@ -68,10 +70,18 @@ fn bend(kind: ElementKind, layers: usize, elastic: bool) -> Curve {
     } else {
         Model::new(mesh, Arc::new(material)).unwrap()
     };
-    model.prescribe("x-", "x", ScalarSchedule::constant(0.0)).unwrap();
-    model.prescribe("y-", "y", ScalarSchedule::constant(0.0)).unwrap();
-    model.prescribe("y+", "y", ScalarSchedule::constant(0.0)).unwrap();
-    model.prescribe("base", "z", ScalarSchedule::constant(0.0)).unwrap();
+    model
+        .prescribe("x-", "x", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .prescribe("y-", "y", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .prescribe("y+", "y", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .prescribe("base", "z", ScalarSchedule::constant(0.0))
+        .unwrap();
     for (k, z) in levels.iter().enumerate() {
         let table = (0..=STEPS)
             .map(|i| {
@@ -118,7 +128,11 @@ fn bend(kind: ElementKind, layers: usize, elastic: bool) -> Curve {
             .iter()
             .map(|&n| {
                 let d = pos(n) - centre;
-                let f = Vec3::new(eval.f_int[3 * n], eval.f_int[3 * n + 1], eval.f_int[3 * n + 2]);
+                let f = Vec3::new(
+                    eval.f_int[3 * n],
+                    eval.f_int[3 * n + 1],
+                    eval.f_int[3 * n + 2],
+                );
                 d.z * f.x - d.x * f.z
             })
             .sum();
@@ -137,7 +151,10 @@ fn springback(c: &Curve) -> f64 {
             return c.kappa[i] + (c.kappa[i + 1] - c.kappa[i]) * m0 / (m0 - m1);
         }
     }
-    panic!("the moment does not change sign while unloading: {:?}", c.moment);
+    panic!(
+        "the moment does not change sign while unloading: {:?}",
+        c.moment
+    );
 }
 
 /// Moment per unit width within 1 % at every loading increment from `κ = 1/(50 t)` on,
@@ -179,7 +196,11 @@ fn one_solid_shell_layer_bends_and_springs_back_like_eight_fbar_layers() {
     );
     assert!(worst < 0.01, "moment difference {worst}");
     assert!((ks / kf - 1.0).abs() < 0.02, "springback {ks} vs {kf}");
-    assert!(shell.iterations.iter().all(|&n| n <= 8), "{:?}", shell.iterations);
+    assert!(
+        shell.iterations.iter().all(|&n| n <= 8),
+        "{:?}",
+        shell.iterations
+    );
 }
 
 /// Elastic check of the set-up and of the element: with a Hencky-elastic material the
@@ -194,8 +215,7 @@ fn elastic_bending_moment_is_plate_theory() {
     let exact = 210e3 / (1.0 - 0.09) * shell.kappa[0] * T.powi(3) / 12.0;
     println!(
         "elastic: solid-shell {:.6}, F-bar {:.6}, plate theory {exact:.6}",
-        -shell.moment[0],
-        -fbar.moment[0]
+        -shell.moment[0], -fbar.moment[0]
     );
     assert!((-shell.moment[0] / exact - 1.0).abs() < 1e-4);
 }

@@ -66,11 +66,17 @@ fn thin_cantilever_one_layer() {
     let tip = |kind: ElementKind, theory: StrainTheory| {
         let mesh = Mesh::block(Vec3::zeros(), Vec3::new(L, T, T), [10, 1, 1]).unwrap();
         let mut model = Model::new(mesh, Arc::new(LinearElastic::new(e, 0.3).unwrap())).unwrap();
-        model.prescribe("x-", "xz", ScalarSchedule::constant(0.0)).unwrap();
+        model
+            .prescribe("x-", "xz", ScalarSchedule::constant(0.0))
+            .unwrap();
         let corner = model.nodes("x-").unwrap()[0];
         model.mesh.add_node_set("corner", vec![corner]).unwrap();
-        model.prescribe("corner", "y", ScalarSchedule::constant(0.0)).unwrap();
-        model.add_load("x+", Vec3::new(0.0, 0.0, -p), ramp()).unwrap();
+        model
+            .prescribe("corner", "y", ScalarSchedule::constant(0.0))
+            .unwrap();
+        model
+            .add_load("x+", Vec3::new(0.0, 0.0, -p), ramp())
+            .unwrap();
         solid_shell(&mut model, theory);
         model.settings.element = kind;
         let nodes = model.nodes("x+").unwrap();
@@ -89,7 +95,11 @@ fn thin_cantilever_one_layer() {
     );
     assert!((small / beam - 1.0).abs() < 0.01, "{}", small / beam);
     assert!((finite / beam - 1.0).abs() < 0.01, "{}", finite / beam);
-    assert!(fbar / beam < 0.5, "the F-bar hexahedron locks: {}", fbar / beam);
+    assert!(
+        fbar / beam < 0.5,
+        "the F-bar hexahedron locks: {}",
+        fbar / beam
+    );
 }
 
 /// Kirchhoff centre deflection of a simply supported square plate (side `a`) under
@@ -99,7 +109,11 @@ fn kirchhoff_plate(q: f64, a: f64, d: f64) -> f64 {
     let mut s = 0.0;
     for m in (1..800).step_by(2) {
         for n in (1..800).step_by(2) {
-            let sign = if ((m + n) / 2 - 1) % 2 == 0 { 1.0 } else { -1.0 };
+            let sign = if ((m + n) / 2 - 1) % 2 == 0 {
+                1.0
+            } else {
+                -1.0
+            };
             let (mf, nf) = (m as f64, n as f64);
             s += sign / (mf * nf * (mf * mf + nf * nf).powi(2));
         }
@@ -117,22 +131,37 @@ fn simply_supported_plate_one_layer() {
     let mut mesh = Mesh::block(Vec3::zeros(), Vec3::new(L, L, T), [8, 8, 1]).unwrap();
     let mid_x = mesh.select_nodes(|p| (p.x - L / 2.0).abs() < 1e-9);
     let mid_y = mesh.select_nodes(|p| (p.y - L / 2.0).abs() < 1e-9);
-    let centre: Vec<usize> = mid_x.iter().copied().filter(|n| mid_y.contains(n)).collect();
+    let centre: Vec<usize> = mid_x
+        .iter()
+        .copied()
+        .filter(|n| mid_y.contains(n))
+        .collect();
     mesh.add_node_set("mid_x", mid_x).unwrap();
     mesh.add_node_set("mid_y", mid_y).unwrap();
     let mut model = Model::new(mesh, Arc::new(LinearElastic::new(e, nu).unwrap())).unwrap();
     for side in ["x-", "x+", "y-", "y+"] {
-        model.prescribe(side, "z", ScalarSchedule::constant(0.0)).unwrap();
+        model
+            .prescribe(side, "z", ScalarSchedule::constant(0.0))
+            .unwrap();
     }
-    model.prescribe("mid_x", "x", ScalarSchedule::constant(0.0)).unwrap();
-    model.prescribe("mid_y", "y", ScalarSchedule::constant(0.0)).unwrap();
-    model.add_load("z+", Vec3::new(0.0, 0.0, -q * L * L), ramp()).unwrap();
+    model
+        .prescribe("mid_x", "x", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .prescribe("mid_y", "y", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .add_load("z+", Vec3::new(0.0, 0.0, -q * L * L), ramp())
+        .unwrap();
     solid_shell(&mut model, StrainTheory::Small);
     let sim = run(model);
     let w = mean(&sim, &centre, |u| -u.z);
     let d = e * T.powi(3) / (12.0 * (1.0 - nu * nu));
     let reference = kirchhoff_plate(q, L, d);
-    println!("plate 8x8x1: centre {w:.6e}, Kirchhoff {reference:.6e}, ratio {:.5}", w / reference);
+    println!(
+        "plate 8x8x1: centre {w:.6e}, Kirchhoff {reference:.6e}, ratio {:.5}",
+        w / reference
+    );
     assert!((w / reference - 1.0).abs() < 0.02, "{}", w / reference);
 }
 
@@ -144,7 +173,12 @@ fn simply_supported_plate_one_layer() {
 #[test]
 fn scordelis_lo_roof() {
     let (r, half, t, angle) = (25.0, 25.0, 0.25, 40f64.to_radians());
-    let block = Mesh::block(Vec3::new(0.0, 0.0, -t / 2.0), Vec3::new(half, angle, t), [16, 16, 1]).unwrap();
+    let block = Mesh::block(
+        Vec3::new(0.0, 0.0, -t / 2.0),
+        Vec3::new(half, angle, t),
+        [16, 16, 1],
+    )
+    .unwrap();
     let mesh = block
         .map(|p| {
             let rr = r + p.z;
@@ -152,13 +186,23 @@ fn scordelis_lo_roof() {
         })
         .unwrap();
     let mut model = Model::new(mesh, Arc::new(LinearElastic::new(4.32e8, 0.0).unwrap())).unwrap();
-    model.prescribe("x+", "yz", ScalarSchedule::constant(0.0)).unwrap(); // diaphragm
-    model.prescribe("x-", "x", ScalarSchedule::constant(0.0)).unwrap(); // mid-length symmetry
-    model.prescribe("y-", "y", ScalarSchedule::constant(0.0)).unwrap(); // crown symmetry
+    model
+        .prescribe("x+", "yz", ScalarSchedule::constant(0.0))
+        .unwrap(); // diaphragm
+    model
+        .prescribe("x-", "x", ScalarSchedule::constant(0.0))
+        .unwrap(); // mid-length symmetry
+    model
+        .prescribe("y-", "y", ScalarSchedule::constant(0.0))
+        .unwrap(); // crown symmetry
     let weight = 90.0 * half * r * angle;
     // Self weight: half on each face's nodes.
-    model.add_load("z+", Vec3::new(0.0, 0.0, -weight / 2.0), ramp()).unwrap();
-    model.add_load("z-", Vec3::new(0.0, 0.0, -weight / 2.0), ramp()).unwrap();
+    model
+        .add_load("z+", Vec3::new(0.0, 0.0, -weight / 2.0), ramp())
+        .unwrap();
+    model
+        .add_load("z-", Vec3::new(0.0, 0.0, -weight / 2.0), ramp())
+        .unwrap();
     solid_shell(&mut model, StrainTheory::Small);
     let edge: Vec<usize> = model
         .nodes("x-")
@@ -169,7 +213,10 @@ fn scordelis_lo_roof() {
     assert_eq!(edge.len(), 2);
     let sim = run(model);
     let w = mean(&sim, &edge, |u| -u.z);
-    println!("Scordelis-Lo 16x16x1: {w:.5} (reference 0.3024, ratio {:.4})", w / 0.3024);
+    println!(
+        "Scordelis-Lo 16x16x1: {w:.5} (reference 0.3024, ratio {:.4})",
+        w / 0.3024
+    );
     assert!((w / 0.3024 - 1.0).abs() < 0.02, "{w}");
 }
 
@@ -190,12 +237,20 @@ fn pinched_hemisphere() {
     let mesh = block
         .map(|p| {
             let (a, b, rr) = (p.x, p.y, r + p.z);
-            Ok(Vec3::new(rr * b.cos() * a.cos(), rr * b.cos() * a.sin(), rr * b.sin()))
+            Ok(Vec3::new(
+                rr * b.cos() * a.cos(),
+                rr * b.cos() * a.sin(),
+                rr * b.sin(),
+            ))
         })
         .unwrap();
     let mut model = Model::new(mesh, Arc::new(LinearElastic::new(6.825e7, 0.3).unwrap())).unwrap();
-    model.prescribe("x-", "y", ScalarSchedule::constant(0.0)).unwrap(); // plane y = 0
-    model.prescribe("x+", "x", ScalarSchedule::constant(0.0)).unwrap(); // plane x = 0
+    model
+        .prescribe("x-", "y", ScalarSchedule::constant(0.0))
+        .unwrap(); // plane y = 0
+    model
+        .prescribe("x+", "x", ScalarSchedule::constant(0.0))
+        .unwrap(); // plane x = 0
     let equator = model.nodes("y-").unwrap();
     let on = |set: &str| -> Vec<usize> {
         let s = model.nodes(set).unwrap();
@@ -212,18 +267,22 @@ fn pinched_hemisphere() {
         })
         .collect();
     model.mesh.add_node_set("hold_z", mid).unwrap();
-    model.prescribe("hold_z", "z", ScalarSchedule::constant(0.0)).unwrap();
+    model
+        .prescribe("hold_z", "z", ScalarSchedule::constant(0.0))
+        .unwrap();
     point_load(&mut model, at_x.clone(), Vec3::new(1.0, 0.0, 0.0));
     point_load(&mut model, at_y.clone(), Vec3::new(0.0, -1.0, 0.0));
     solid_shell(&mut model, StrainTheory::Small);
     let sim = run(model);
     let ux = mean(&sim, &at_x, |u| u.x);
     let uy = mean(&sim, &at_y, |u| -u.y);
-    println!("hemisphere 16x16x1: u_x {ux:.5}, -u_y {uy:.5} (reference 0.0940, ratio {:.4})", ux / 0.094);
+    println!(
+        "hemisphere 16x16x1: u_x {ux:.5}, -u_y {uy:.5} (reference 0.0940, ratio {:.4})",
+        ux / 0.094
+    );
     assert!((ux / 0.094 - 1.0).abs() < 0.02, "{ux}");
     assert!((uy / 0.094 - 1.0).abs() < 0.02, "{uy}");
 }
-
 
 /// A mesh without through-thickness node columns (built from its nodes and hexahedra)
 /// is refused for the solid-shell with a message naming the cause; so is an element whose
@@ -235,7 +294,10 @@ fn solid_shell_needs_node_columns() {
     let mut model = Model::new(loose, Arc::new(LinearElastic::new(1.0, 0.0).unwrap())).unwrap();
     model.settings.element = ElementKind::SolidShell;
     let err = Simulation::new(model).err().unwrap().to_string();
-    assert!(err.contains("solid_shell") && err.contains("columns"), "{err}");
+    assert!(
+        err.contains("solid_shell") && err.contains("columns"),
+        "{err}"
+    );
     // Turned: ζ along y, so edge 0-4 is not a column step.
     let mut turned = block.clone();
     for h in &mut turned.hexes {
@@ -266,8 +328,12 @@ fn large_rotation_cantilever_reaches_the_elastica() {
     let p = alpha * ei / (L * L);
     let mesh = Mesh::block(Vec3::zeros(), Vec3::new(L, T, T), [20, 1, 1]).unwrap();
     let mut model = Model::new(mesh, Arc::new(LinearElastic::new(e, 0.0).unwrap())).unwrap();
-    model.prescribe("x-", "xyz", ScalarSchedule::constant(0.0)).unwrap();
-    model.add_load("x+", Vec3::new(0.0, 0.0, -p), ramp()).unwrap();
+    model
+        .prescribe("x-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    model
+        .add_load("x+", Vec3::new(0.0, 0.0, -p), ramp())
+        .unwrap();
     solid_shell(&mut model, StrainTheory::Finite);
     model.settings.increments = 10;
     model.settings.force_rel_tol = 1e-10;
@@ -280,7 +346,10 @@ fn large_rotation_cantilever_reaches_the_elastica() {
         assert_eq!(report.cutbacks, 0);
         iterations.push(report.iterations);
         let r: Vec<f64> = report.residuals.iter().map(|x| x.force_rel).collect();
-        println!("residuals {:?}", r.iter().map(|x| format!("{x:.1e}")).collect::<Vec<_>>());
+        println!(
+            "residuals {:?}",
+            r.iter().map(|x| format!("{x:.1e}")).collect::<Vec<_>>()
+        );
         let n = r.len();
         // The converging step: quadratic, or at the round-off floor.
         finals.push((r[n - 1], r[n - 1] / (r[n - 2] * r[n - 2])));

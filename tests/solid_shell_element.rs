@@ -49,7 +49,11 @@ fn distorted_element() -> [Vec3; 8] {
     std::array::from_fn(|a| {
         let c = HEX_CORNERS[a];
         let p = Vec3::new(0.5 * c[0], 0.5 * c[1], 0.5 * THICKNESS * c[2]);
-        p + Vec3::new(0.15 * rng.next(), 0.15 * rng.next(), 0.2 * THICKNESS * rng.next())
+        p + Vec3::new(
+            0.15 * rng.next(),
+            0.15 * rng.next(),
+            0.2 * THICKNESS * rng.next(),
+        )
     })
 }
 
@@ -72,7 +76,13 @@ fn evaluate(
 /// Largest relative difference between the tangent and central differences of the force
 /// (step 1e-8 on a 0.1-thick element: truncation ~1e-16 relative, round-off
 /// ~1e-16 |f| / 1e-8 ~ 1e-8 |K| h).
-fn fd_error(el: &SolidShell, x: &[Vec3; 8], u: &[Vec3; 8], committed: &[PointState], m: &dyn Material) -> f64 {
+fn fd_error(
+    el: &SolidShell,
+    x: &[Vec3; 8],
+    u: &[Vec3; 8],
+    committed: &[PointState],
+    m: &dyn Material,
+) -> f64 {
     let (_, k, _) = evaluate(el, x, u, committed, m);
     let h = 1e-8;
     let scale = k.amax();
@@ -106,7 +116,10 @@ fn tangent_equals_central_differences() {
     for finite in [true, false] {
         let el = shell(finite);
         let target = if finite { u } else { u_small };
-        for (name, m) in [("elastic", &elastic as &dyn Material), ("plastic", &plastic)] {
+        for (name, m) in [
+            ("elastic", &elastic as &dyn Material),
+            ("plastic", &plastic),
+        ] {
             let half: [Vec3; 8] = if finite {
                 std::array::from_fn(|a| rot * (x[a] + strain[a] * 0.6) - x[a])
             } else {
@@ -194,8 +207,16 @@ fn solve_patch(
         .zip(boundary)
         .enumerate()
         .map(|(i, (p, b))| {
-            let wobble = Vec3::new((i as f64).sin(), (2.0 * i as f64).cos(), (3.0 * i as f64).sin());
-            if *b { exact(*p) } else { exact(*p) + wobble * 1e-3 }
+            let wobble = Vec3::new(
+                (i as f64).sin(),
+                (2.0 * i as f64).cos(),
+                (3.0 * i as f64).sin(),
+            );
+            if *b {
+                exact(*p)
+            } else {
+                exact(*p) + wobble * 1e-3
+            }
         })
         .collect();
     let committed = vec![PointState::default(); hexes.len() * np];
@@ -207,14 +228,21 @@ fn solve_patch(
             let x: [Vec3; 8] = hex.map(|n| nodes[n]);
             let ue: [Vec3; 8] = hex.map(|n| u[n]);
             let r = el
-                .evaluate(&x, &ue, &committed[e * np..(e + 1) * np], &mut trial[e * np..(e + 1) * np], m)
+                .evaluate(
+                    &x,
+                    &ue,
+                    &committed[e * np..(e + 1) * np],
+                    &mut trial[e * np..(e + 1) * np],
+                    m,
+                )
                 .unwrap();
             for a in 0..8 {
                 for i in 0..3 {
                     f[3 * hex[a] + i] += r.force[3 * a + i];
                     for b in 0..8 {
                         for j in 0..3 {
-                            k[(3 * hex[a] + i, 3 * hex[b] + j)] += r.stiffness[(3 * a + i, 3 * b + j)];
+                            k[(3 * hex[a] + i, 3 * hex[b] + j)] +=
+                                r.stiffness[(3 * a + i, 3 * b + j)];
                         }
                     }
                 }
@@ -267,10 +295,15 @@ fn membrane_patch_test_finite_strain() {
     let el = shell(true);
     let (u, states) = solve_patch(&el, &nodes, &hexes, &boundary, &exact, &m);
     let mut reference = PointState::default();
-    m.update_finite(&f, &PointState::default(), &mut reference).unwrap();
+    m.update_finite(&f, &PointState::default(), &mut reference)
+        .unwrap();
     let scale = reference.stress.amax();
     for (n, p) in nodes.iter().enumerate() {
-        assert!((u[n] - exact(*p)).amax() < 1e-10, "node {n}: {:?}", u[n] - exact(*p));
+        assert!(
+            (u[n] - exact(*p)).amax() < 1e-10,
+            "node {n}: {:?}",
+            u[n] - exact(*p)
+        );
     }
     let worst = states
         .iter()
@@ -300,7 +333,9 @@ fn bending_patch_test_small_strain() {
         Vec3::new(
             -p.z * (a * p.x + c * p.y),
             -p.z * (b * p.y + c * p.x),
-            0.5 * (a * p.x * p.x + b * p.y * p.y) + c * p.x * p.y + nu / (1.0 - nu) * (a + b) * p.z * p.z / 2.0,
+            0.5 * (a * p.x * p.x + b * p.y * p.y)
+                + c * p.x * p.y
+                + nu / (1.0 - nu) * (a + b) * p.z * p.z / 2.0,
         )
     };
     let el = shell(false);
@@ -326,7 +361,10 @@ fn bending_patch_test_small_strain() {
             worst = worst.max((states[e * np + p].stress - sigma).amax());
         }
     }
-    println!("bending patch: worst stress error {:.2e} of {scale:.3e}", worst / scale);
+    println!(
+        "bending patch: worst stress error {:.2e} of {scale:.3e}",
+        worst / scale
+    );
     assert!(worst < 1e-8 * scale, "{:e}", worst / scale);
 }
 
@@ -374,4 +412,3 @@ fn rigid_rotation_of_a_plastic_element_is_objective() {
     println!("objectivity: worst {worst:.2e}");
     assert!(worst < 1e-8, "{worst:e}");
 }
-

@@ -249,7 +249,10 @@ fn run_cup_eliminate(variant: &str, eliminate: bool, out: &Path) -> Value {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(root.join("scripts/square_cup.rhai")).unwrap();
     let marker = "linear_solver: linear_solver,";
-    assert!(source.contains(marker), "the cup script sets its linear solver");
+    assert!(
+        source.contains(marker),
+        "the cup script sets its linear solver"
+    );
     let source = source.replace(
         marker,
         &format!("{marker} eliminate_multipliers: {eliminate},"),
@@ -268,7 +271,10 @@ fn run_cup_eliminate(variant: &str, eliminate: bool, out: &Path) -> Value {
         .arg(format!("variant=\"{variant}\""))
         .status()
         .expect("tribo runs");
-    assert!(status.success(), "square cup ({variant}, eliminate {eliminate}) failed");
+    assert!(
+        status.success(),
+        "square cup ({variant}, eliminate {eliminate}) failed"
+    );
     let _ = std::fs::remove_dir_all(&folder);
     let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
     serde_json::from_str(&text).expect("summary.json is JSON")
@@ -320,8 +326,14 @@ fn condensed_and_mixed_cups_agree() {
             .map(|k| (da[k].as_f64().unwrap() - db[k].as_f64().unwrap()).abs() / size)
             .fold(0.0f64, f64::max);
         println!("{variant}: forces differ by {worst_force:.1e}, draw-in by {worst_draw_in:.1e}");
-        assert!(worst_force < CONDENSED_BOUND, "{variant}: forces differ by {worst_force:e}");
-        assert!(worst_draw_in < CONDENSED_BOUND, "{variant}: draw-in differs by {worst_draw_in:e}");
+        assert!(
+            worst_force < CONDENSED_BOUND,
+            "{variant}: forces differ by {worst_force:e}"
+        );
+        assert!(
+            worst_draw_in < CONDENSED_BOUND,
+            "{variant}: draw-in differs by {worst_draw_in:e}"
+        );
         let _ = std::fs::remove_dir_all(&out_a);
         let _ = std::fs::remove_dir_all(&out_b);
     }

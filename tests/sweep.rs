@@ -59,8 +59,7 @@ fn bash(script: &Path, task: Option<usize>) {
 /// A run's summary.json without what depends on the machine's load (times).
 fn summary(dir: &Path) -> Value {
     let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut v: Value = serde_json::from_str(&text).unwrap();
     let m = v.as_object_mut().unwrap();
     m.remove("wall_time_s");
@@ -116,7 +115,11 @@ fn local_jobs_one_by_one_parallel_file_and_slurm_array_agree_and_collect_charts(
         let fx = |s: &Value| s["tools"]["roller"]["final_force"][0].as_f64().unwrap();
         for s in block {
             let (a, b) = (fx(s), fx(&block[0]));
-            assert!((a - b).abs() <= 1e-8 * b.abs(), "mu = {}: {a} against {b}", MU[k]);
+            assert!(
+                (a - b).abs() <= 1e-8 * b.abs(),
+                "mu = {}: {a} against {b}",
+                MU[k]
+            );
         }
     }
     let iterations: Vec<u64> = by_hand
@@ -155,7 +158,11 @@ fn local_jobs_one_by_one_parallel_file_and_slurm_array_agree_and_collect_charts(
     assert!(!run_dir(&parallel, 0).exists(), "--emit ran something");
     bash(&commands, None);
     for (i, expected) in by_hand.iter().enumerate() {
-        assert_eq!(&summary(&run_dir(&parallel, i)), expected, "run {i}, parallel file");
+        assert_eq!(
+            &summary(&run_dir(&parallel, i)),
+            expected,
+            "run {i}, parallel file"
+        );
     }
 
     // The Slurm job array: its form, and one task run by bash with its index set.
@@ -166,14 +173,24 @@ fn local_jobs_one_by_one_parallel_file_and_slurm_array_agree_and_collect_charts(
     let text = std::fs::read_to_string(&job).unwrap();
     assert!(text.starts_with("#!/bin/bash\n"));
     let directives: Vec<&str> = text.lines().filter(|l| l.starts_with("#SBATCH ")).collect();
-    assert!(directives.contains(&format!("#SBATCH --array=0-{}", n - 1).as_str()), "{text}");
+    assert!(
+        directives.contains(&format!("#SBATCH --array=0-{}", n - 1).as_str()),
+        "{text}"
+    );
     assert!(directives.contains(&"#SBATCH --ntasks=1"), "{text}");
     assert!(text.contains("SLURM_ARRAY_TASK_ID") && text.contains("commands.txt"));
     let task = 7;
     bash(&job, Some(task));
-    assert_eq!(summary(&run_dir(&slurm, task)), by_hand[task], "slurm task {task}");
+    assert_eq!(
+        summary(&run_dir(&slurm, task)),
+        by_hand[task],
+        "slurm task {task}"
+    );
     for i in (0..n).filter(|&i| i != task) {
-        assert!(!run_dir(&slurm, i).join("summary.json").exists(), "task {task} ran run {i}");
+        assert!(
+            !run_dir(&slurm, i).join("summary.json").exists(),
+            "task {task} ran run {i}"
+        );
     }
 
     // Collect: the table of all runs and the chart.
@@ -195,13 +212,19 @@ fn local_jobs_one_by_one_parallel_file_and_slurm_array_agree_and_collect_charts(
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(&header[..3], ["id", "mu", "r"]);
     let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let (fx, its) = (column("tools.roller.final_force.0"), column("newton_iterations"));
+    let (fx, its) = (
+        column("tools.roller.final_force.0"),
+        column("newton_iterations"),
+    );
     let body: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(body.len(), n);
     for (i, (cells, s)) in body.iter().zip(&by_hand).enumerate() {
         assert_eq!(cells[0], format!("run_{i:03}"));
         let force: f64 = cells[fx].parse().unwrap();
-        assert_eq!(force, s["tools"]["roller"]["final_force"][0].as_f64().unwrap());
+        assert_eq!(
+            force,
+            s["tools"]["roller"]["final_force"][0].as_f64().unwrap()
+        );
         assert_eq!(cells[its], s["newton_iterations"].to_string());
     }
     let svg = std::fs::read_to_string(&chart).unwrap();

@@ -141,7 +141,11 @@ pub fn measure(
 /// Mean wall and CPU milliseconds of faer's numeric LL^T (after its symbolic analysis) of
 /// the SPD matrix on the pattern of `A + A^T`, and the entries of L; in faer's AMD order,
 /// or (`grouped`) in the default solver's order over elimination groups.
-pub fn cholesky_floor(p: &SparsePattern, repeats: usize, grouped: bool) -> Result<(f64, f64, usize)> {
+pub fn cholesky_floor(
+    p: &SparsePattern,
+    repeats: usize,
+    grouped: bool,
+) -> Result<(f64, f64, usize)> {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::linalg::cholesky::llt::factor::LltRegularization;
     use faer::sparse::linalg::cholesky::{
@@ -174,7 +178,9 @@ pub fn cholesky_floor(p: &SparsePattern, repeats: usize, grouped: bool) -> Resul
         }
     }
     for (c, d) in degree.iter().enumerate() {
-        let k = lower.position(c, c).expect("the diagonal is in the pattern");
+        let k = lower
+            .position(c, c)
+            .expect("the diagonal is in the pattern");
         m.values[k] = d + 1.0;
     }
     let sym = SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
@@ -183,7 +189,9 @@ pub fn cholesky_floor(p: &SparsePattern, repeats: usize, grouped: bool) -> Resul
         _ => None,
     };
     let ordering = match &order {
-        Some((fwd, inv)) => SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, n)),
+        Some((fwd, inv)) => {
+            SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, n))
+        }
         None => SymmetricOrdering::Amd,
     };
     let symbolic = factorize_symbolic_cholesky(

@@ -518,10 +518,7 @@ fn table(result: &CaseResult) -> String {
             }
         }
         let (cpu, cpu_ms) = match (t.cpu_s, b.cpu_s) {
-            (Some(x), Some(y)) => (
-                ratio(x, y),
-                ratio(t.ms_per_iteration, b.ms_per_iteration),
-            ),
+            (Some(x), Some(y)) => (ratio(x, y), ratio(t.ms_per_iteration, b.ms_per_iteration)),
             _ => ("-".into(), "-".into()),
         };
         r += &format!(

@@ -640,7 +640,10 @@ pub(super) mod tests {
         let u: Vec<Vec3> = (0..8).map(|_| rng.vec() * 0.03).collect();
         let mut trial = states();
         let r = Hex8.evaluate(&x, &u, &states(), &mut trial, &m).unwrap();
-        assert!(trial.iter().all(|t| t.eq_plastic_strain > 0.0), "must yield");
+        assert!(
+            trial.iter().all(|t| t.eq_plastic_strain > 0.0),
+            "must yield"
+        );
         let (b, dv) = Hex8.strain_displacement(&x).unwrap();
         let ue = SVector::<f64, DOFS>::from_fn(|i, _| u[i / 3][i % 3]);
         let (mut force, mut stiffness) = (
@@ -664,8 +667,16 @@ pub(super) mod tests {
         assert!((r.stiffness - stiffness).amax() <= 1e-13 * stiffness.amax());
         let mut residual_trial = states();
         let mut residual = [0.0; DOFS];
-        Hex8.evaluate_into(&x, &u, &states(), &mut residual_trial, &m, &mut residual, None)
-            .unwrap();
+        Hex8.evaluate_into(
+            &x,
+            &u,
+            &states(),
+            &mut residual_trial,
+            &m,
+            &mut residual,
+            None,
+        )
+        .unwrap();
         assert_eq!(residual.as_slice(), r.force.as_slice());
         assert_eq!(residual_trial, trial);
     }

@@ -387,8 +387,8 @@ impl Element<DOFS> for Hex8FBar {
 mod tests {
     use super::*;
     use crate::element::hex8::tests::{distorted_element, Lcg};
-    use nalgebra::SVector;
     use crate::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
+    use nalgebra::SVector;
 
     fn hill_swift() -> ElastoPlastic {
         ElastoPlastic::new(

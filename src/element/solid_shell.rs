@@ -699,10 +699,7 @@ impl Element<DOFS> for SolidShell {
         let points = self.points(&x, &u)?;
         let ne = self.modes();
         let mut alpha: Vec<f64> = committed[0].enhanced[..ne].to_vec();
-        let strain_scale = points
-            .iter()
-            .map(|p| p.strain.amax())
-            .fold(0.0, f64::max);
+        let strain_scale = points.iter().map(|p| p.strain.amax()).fold(0.0, f64::max);
         let mut stresses = vec![Voigt::zeros(); points.len()];
         let mut tangents = vec![Tangent::zeros(); points.len()];
         let mut k_aa = DMatrix::<f64>::zeros(ne, ne);
@@ -724,9 +721,10 @@ impl Element<DOFS> for SolidShell {
                 stresses[p] = s;
                 tangents[p] = c;
             }
-            let step = k_aa.clone().lu().solve(&r_a).ok_or_else(|| {
-                Error::NoConvergence("singular enhanced-strain stiffness".into())
-            })?;
+            let step =
+                k_aa.clone().lu().solve(&r_a).ok_or_else(|| {
+                    Error::NoConvergence("singular enhanced-strain stiffness".into())
+                })?;
             let size = step.amax();
             let scale = strain_scale.max(alpha.iter().fold(0.0, |m, a| m.max(a.abs())));
             // Converged, or stalled at round-off (the step no longer shrinks).
@@ -844,13 +842,18 @@ mod tests {
         for n in 1..=MAX_THICKNESS_POINTS {
             let (x, w) = gauss_legendre(n);
             for d in 0..2 * n {
-                let exact = if d % 2 == 0 { 2.0 / (d as f64 + 1.0) } else { 0.0 };
+                let exact = if d % 2 == 0 {
+                    2.0 / (d as f64 + 1.0)
+                } else {
+                    0.0
+                };
                 let sum: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(d as i32)).sum();
                 assert!((sum - exact).abs() < 1e-13, "Gauss {n}, degree {d}: {sum}");
             }
             assert!(x.windows(2).all(|p| p[0] < p[1]));
             let (x, w) = thickness_rule(n);
-            let sum = |f: &dyn Fn(f64) -> f64| -> f64 { x.iter().zip(&w).map(|(x, w)| w * f(*x)).sum() };
+            let sum =
+                |f: &dyn Fn(f64) -> f64| -> f64 { x.iter().zip(&w).map(|(x, w)| w * f(*x)).sum() };
             assert!((sum(&|_| 1.0) - 2.0).abs() < 1e-14);
             if n >= 2 {
                 assert!((sum(&|z| z * z) - 2.0 / 3.0).abs() < 1e-14, "{n}");

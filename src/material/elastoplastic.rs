@@ -342,7 +342,6 @@ impl ElastoPlastic {
         };
         Ok(ret.tangent)
     }
-
 }
 
 impl Material for ElastoPlastic {
@@ -445,18 +444,16 @@ mod tests {
         let mut compared = 0;
         for yf in yields {
             for law in &laws {
-                let m = ElastoPlastic::new(
-                    LinearElastic::new(70e3, 0.33).unwrap(),
-                    yf,
-                    law.clone(),
-                );
+                let m =
+                    ElastoPlastic::new(LinearElastic::new(70e3, 0.33).unwrap(), yf, law.clone());
                 for _ in 0..40 {
                     let ebar_n = 0.1 * (1.0 + rnd());
                     let sy = law.yield_stress(ebar_n);
                     let dir = Voigt::from_fn(|_, _| rnd());
                     let phi = yf.equivalent_stress(&dir);
                     let scale = sy * (1.2 + 10.0 * (1.0 + rnd())) / phi;
-                    let sig_tr = dir * scale + Voigt::new(1.0, 1.0, 1.0, 0.0, 0.0, 0.0) * (rnd() * sy);
+                    let sig_tr =
+                        dir * scale + Voigt::new(1.0, 1.0, 1.0, 0.0, 0.0, 0.0) * (rnd() * sy);
                     let fast = m.return_map(&sig_tr, ebar_n, true).unwrap();
                     let general = m.return_map_general(&sig_tr, ebar_n).unwrap();
                     let sig_scale = sig_tr.amax();

@@ -249,7 +249,10 @@ mod tests {
             for e in [0.0, 1e-5, 0.05, 0.2, 0.5] {
                 let (sy, h) = law.yield_stress_and_slope(e);
                 assert_eq!(sy, law.yield_stress(e), "{law:?} at {e}");
-                assert!((h - law.slope(e)).abs() <= 1e-14 * h.abs(), "{law:?} at {e}");
+                assert!(
+                    (h - law.slope(e)).abs() <= 1e-14 * h.abs(),
+                    "{law:?} at {e}"
+                );
             }
         }
     }

@@ -16,7 +16,10 @@ impl Mesh {
             let q = f(*p)?;
             if !q.iter().all(|c| c.is_finite()) {
                 return Err(Error::input(
-                    &format!("mapped coordinates of node {i} (from ({}, {}, {}))", p.x, p.y, p.z),
+                    &format!(
+                        "mapped coordinates of node {i} (from ({}, {}, {}))",
+                        p.x, p.y, p.z
+                    ),
                     format!("({}, {}, {})", q.x, q.y, q.z),
                     "must be finite",
                 ));
@@ -57,8 +60,14 @@ mod tests {
             assert!(((p.x * p.x + p.z * p.z).sqrt() - r0).abs() < 1e-12);
         }
         // A mirror inverts every element: refused, naming the element.
-        let err = m.map(|p| Ok(Vec3::new(-p.x, p.y, p.z))).unwrap_err().to_string();
-        assert!(err.contains("mesh.map") && err.contains("element 0"), "{err}");
+        let err = m
+            .map(|p| Ok(Vec3::new(-p.x, p.y, p.z)))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("mesh.map") && err.contains("element 0"),
+            "{err}"
+        );
         let err = m
             .map(|p| Ok(Vec3::new(p.x / (p.x - 0.5), p.y, p.z)))
             .unwrap_err()

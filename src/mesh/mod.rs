@@ -33,11 +33,11 @@ use crate::{Error, Result};
 
 mod block;
 mod faces;
-mod map;
 pub mod gmsh;
 mod grading;
 mod import;
 pub mod inp;
+mod map;
 mod merge;
 mod sets;
 

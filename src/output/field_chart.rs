@@ -88,7 +88,12 @@ pub struct MapView {
 
 /// The colour map of field `field` on the boundary faces within node set `face_set`,
 /// seen along -z (x right, y up), at the committed state of `sim`.
-pub fn field_map(sim: &Simulation, face_set: &str, field: &str, view: &MapView) -> Result<FieldMap> {
+pub fn field_map(
+    sim: &Simulation,
+    face_set: &str,
+    field: &str,
+    view: &MapView,
+) -> Result<FieldMap> {
     let mesh = &sim.model.mesh;
     let nodes = mesh.node_set(face_set)?;
     let quads = mesh.faces_within(nodes)?;

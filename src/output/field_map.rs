@@ -3,8 +3,8 @@
 
 use super::fmt_f64;
 use super::svg::{
-    data_range, hex, nice_ticks, px, svg_open, text, tick_label, viridis, write_pair,
-    y_tick_label, NO_VALUE, VIRIDIS,
+    data_range, hex, nice_ticks, px, svg_open, text, tick_label, viridis, write_pair, y_tick_label,
+    NO_VALUE, VIRIDIS,
 };
 use crate::{Error, Result};
 use std::fmt::Write as _;
@@ -35,7 +35,6 @@ pub struct FieldMap {
     pub x_label: String,
     pub y_label: String,
 }
-
 
 impl FieldMap {
     fn check(&self) -> Result<()> {
@@ -338,7 +337,6 @@ impl FieldMap {
     }
 }
 
-
 /// A pixel coordinate in at most one decimal, without a trailing ".0".
 fn short(x: f64) -> String {
     let s = format!("{:.1}", x);
@@ -354,7 +352,10 @@ fn short(x: f64) -> String {
 /// other is given to 4 significant digits (0.00999 is not shown as "0.01").
 fn end_label(v: f64, step: f64) -> String {
     let nice = tick_label(v, step);
-    if nice.parse::<f64>().is_ok_and(|p| (p - v).abs() <= 1e-9 * step) {
+    if nice
+        .parse::<f64>()
+        .is_ok_and(|p| (p - v).abs() <= 1e-9 * step)
+    {
         nice
     } else {
         super::significant(v, 4)
@@ -450,12 +451,14 @@ mod tests {
             for j in 0..=n {
                 let (x, y) = (3.0 * i as f64, 3.0 * j as f64);
                 m.points.push([x, y]);
-                m.values.push((x * 0.1).sin() * (y * 0.13).cos() + 1e-3 * x * y);
+                m.values
+                    .push((x * 0.1).sin() * (y * 0.13).cos() + 1e-3 * x * y);
             }
         }
         for i in 0..n {
             for j in 0..n {
-                m.quads.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+                m.quads
+                    .push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
             }
         }
         let svg = m.to_svg().unwrap();

@@ -23,7 +23,6 @@ pub struct LineChart {
     pub series: Vec<Series>,
 }
 
-
 impl LineChart {
     fn check(&self) -> Result<()> {
         if self.series.is_empty() {
@@ -217,7 +216,6 @@ fn axis_of(values: impl Iterator<Item = f64>) -> (f64, f64, Vec<f64>, f64) {
     let (lo, hi) = data_range(values);
     axis(lo, hi, 8)
 }
-
 
 #[cfg(test)]
 mod tests {

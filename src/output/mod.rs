@@ -25,13 +25,13 @@ mod vtk;
 
 pub mod run;
 
+pub use self::blank_frame::{frame, Configuration};
+pub use self::cadence::{Cadence, DEFAULT_FRAMES};
 pub use self::csv::HistoryCsv;
 pub use self::folder::{FolderLock, OutputFolder, LOCK_FILE};
 pub use self::pvd::{PvdEntry, PvdSeries};
 pub use self::run::{OutputOptions, RunOutput, Units};
 pub use self::summary::{write_summary, SUMMARY_FILE};
-pub use self::blank_frame::{frame, Configuration};
-pub use self::cadence::{Cadence, DEFAULT_FRAMES};
 pub use self::tool_frame::tool_frame;
 pub use self::vtk::{
     read_vtu, read_vtu_point_field, write_vtu, Field, Frame, SYMMETRIC_TENSOR_COMPONENTS,

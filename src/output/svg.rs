@@ -174,7 +174,6 @@ pub(crate) fn y_tick_label(out: &mut String, x_axis: f64, y: f64, label: &str) {
     text(out, x_axis - 8.0, y + 4.0, 12.0, "end", "", label);
 }
 
-
 pub(crate) fn write_pair(svg_path: &Path, svg: &str, csv: &str) -> Result<PathBuf> {
     let csv_path = svg_path.with_extension("csv");
     if csv_path == svg_path {
@@ -188,7 +187,6 @@ pub(crate) fn write_pair(svg_path: &Path, svg: &str, csv: &str) -> Result<PathBu
     write_atomic(&csv_path, csv.as_bytes())?;
     Ok(csv_path)
 }
-
 
 #[cfg(test)]
 pub(crate) mod tests {
@@ -271,5 +269,4 @@ pub(crate) mod tests {
         let g: Vec<u8> = (0..=100).map(|i| viridis(i as f64 / 100.0)[1]).collect();
         assert!(g.windows(2).all(|w| w[1] >= w[0]));
     }
-
 }

@@ -100,9 +100,7 @@ mod tests {
         f.validate().unwrap();
         let plane = Tool::new(
             "plane",
-            Arc::new(
-                crate::geometry::Plane::new(Vec3::zeros(), Vec3::new(0.0, 0.0, 1.0)).unwrap(),
-            ),
+            Arc::new(crate::geometry::Plane::new(Vec3::zeros(), Vec3::new(0.0, 0.0, 1.0)).unwrap()),
         );
         assert!(tool_frame(&plane, &pose).is_none());
     }

@@ -230,8 +230,8 @@ pub fn write_vtu(path: &Path, frame: &Frame) -> Result<()> {
     let mut bytes = Vec::new();
     vtk.write_xml(&mut bytes)
         .map_err(|e| Error::io(path, format!("VTK XML encoding failed: {e}")))?;
-    let text = String::from_utf8(bytes)
-        .map_err(|_| Error::io(path, "VTK XML encoding is not UTF-8"))?;
+    let text =
+        String::from_utf8(bytes).map_err(|_| Error::io(path, "VTK XML encoding is not UTF-8"))?;
     let text = with_component_names(text, "PointData", &frame.point_data);
     let text = with_component_names(text, "CellData", &frame.cell_data);
     super::write_atomic(path, text.as_bytes())
@@ -347,7 +347,10 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
             "cell type {t:?} found, only hexahedra and quadrilaterals are supported"
         )));
     }
-    let nhex = types.iter().take_while(|&&t| t == CellType::Hexahedron).count();
+    let nhex = types
+        .iter()
+        .take_while(|&&t| t == CellType::Hexahedron)
+        .count();
     if types[nhex..].iter().any(|&t| t != CellType::Quad) {
         return Err(bad("hexahedra after quadrilaterals".into()));
     }
@@ -371,7 +374,7 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
         .collect();
     if offsets != expected_offsets.as_slice() || connectivity.len() != 8 * nhex + 4 * nquad {
         return Err(bad(
-            "cell offsets are not those of 8-node and 4-node cells".into(),
+            "cell offsets are not those of 8-node and 4-node cells".into()
         ));
     }
     let index = |n: u64| {
@@ -497,10 +500,7 @@ mod tests {
             cell_data: vec![
                 Field::scalar("pressure", vec![1.0 / 3.0, -2.0e-17]),
                 Field::vector("traction", &[[0.1, 0.2, 0.3], [1e300, -5e-324, 0.0]]),
-                Field::symmetric_tensor(
-                    "stress",
-                    (0..12).map(|i| i as f64 / 7.0 - 1.0).collect(),
-                ),
+                Field::symmetric_tensor("stress", (0..12).map(|i| i as f64 / 7.0 - 1.0).collect()),
             ],
         }
     }
@@ -550,7 +550,8 @@ mod tests {
         let path = dir.join("named.vtu");
         let mut frame = two_hex_frame();
         frame.point_data.push(
-            Field::vector("stress", &vec![[1.0, 2.0, 3.0]; 12]).named_components(&["a", "b&c", "d"]),
+            Field::vector("stress", &vec![[1.0, 2.0, 3.0]; 12])
+                .named_components(&["a", "b&c", "d"]),
         );
         frame.quads = vec![[0, 1, 7, 6], [1, 2, 8, 7]];
         frame.cell_data = (frame.cell_data.into_iter())
@@ -568,7 +569,10 @@ mod tests {
         assert!(text.contains("ComponentName1=\"b&amp;c\""), "{text}");
         let back = read_vtu(&path).unwrap();
         assert_eq!(back, frame);
-        assert_eq!(back.cell_data[2].component_names, SYMMETRIC_TENSOR_COMPONENTS);
+        assert_eq!(
+            back.cell_data[2].component_names,
+            SYMMETRIC_TENSOR_COMPONENTS
+        );
         assert_eq!(back.point_data[2].component_names, ["a", "b&c", "d"]);
         assert_eq!(back.quads.len(), 2);
         // vtkio's own reader still accepts the tags with the extra attributes.
@@ -577,7 +581,10 @@ mod tests {
         let mut bad = two_hex_frame();
         bad.cell_data[2].component_names.pop();
         let err = write_vtu(&path, &bad).unwrap_err().to_string();
-        assert!(err.contains("component names") && err.contains("stress"), "{err}");
+        assert!(
+            err.contains("component names") && err.contains("stress"),
+            "{err}"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 

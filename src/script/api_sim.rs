@@ -822,7 +822,9 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             "frame_points" => {
                 let name = v.clone().into_string().unwrap_or_default();
                 st.frames.points = lift(Configuration::parse(&name))
-                    .map_err(|_| format!("frame_points = '{name}' must be \"current\" or \"reference\""))
+                    .map_err(|_| {
+                        format!("frame_points = '{name}' must be \"current\" or \"reference\"")
+                    })
                     .or_else(runtime_error)?;
             }
             "extrapolate" => {
@@ -858,24 +860,37 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
                 s.element = lift(crate::element::ElementKind::from_name(&name))?;
             }
             "thickness_points" => {
-                s.thickness_points =
-                    lift(crate::element::solid_shell::check_thickness_points(count(key)?))?;
+                s.thickness_points = lift(crate::element::solid_shell::check_thickness_points(
+                    count(key)?,
+                ))?;
             }
             "friction_update" => {
-                s.contact.friction_update = match v.clone().into_string().unwrap_or_default().as_str() {
-                    "explicit" => crate::contact::FrictionUpdate::Explicit,
-                    "implicit" => crate::contact::FrictionUpdate::Implicit,
-                    o => return runtime_error(format!("friction_update = '{o}' must be \"explicit\" or \"implicit\"")),
-                }
+                s.contact.friction_update =
+                    match v.clone().into_string().unwrap_or_default().as_str() {
+                        "explicit" => crate::contact::FrictionUpdate::Explicit,
+                        "implicit" => crate::contact::FrictionUpdate::Implicit,
+                        o => {
+                            return runtime_error(format!(
+                                "friction_update = '{o}' must be \"explicit\" or \"implicit\""
+                            ))
+                        }
+                    }
             }
             "curvature" => {
-                s.contact.curvature = v.as_bool().map_err(|t| format!("curvature must be true or false, got {t}")).or_else(runtime_error)?
+                s.contact.curvature = v
+                    .as_bool()
+                    .map_err(|t| format!("curvature must be true or false, got {t}"))
+                    .or_else(runtime_error)?
             }
             "frame" => {
                 s.contact.frame = match v.clone().into_string().unwrap_or_default().as_str() {
                     "every_iteration" => FrameUpdate::EveryIteration,
                     "frozen" => FrameUpdate::Frozen,
-                    o => return runtime_error(format!("frame = '{o}' must be \"every_iteration\" or \"frozen\"")),
+                    o => {
+                        return runtime_error(format!(
+                            "frame = '{o}' must be \"every_iteration\" or \"frozen\""
+                        ))
+                    }
                 }
             }
             "enforcement" => {

@@ -135,7 +135,9 @@ impl Model {
     }
 
     /// The element the settings select (see `element::solid_shell::select`).
-    pub fn element(&self) -> Result<&'static dyn crate::element::Element<{ crate::element::hex8::DOFS }>> {
+    pub fn element(
+        &self,
+    ) -> Result<&'static dyn crate::element::Element<{ crate::element::hex8::DOFS }>> {
         let s = &self.settings;
         crate::element::solid_shell::select(s.element, s.kinematics, s.fbar, s.thickness_points)
     }

@@ -106,24 +106,29 @@ impl Collected {
     /// The chart of output `y` against parameter `x`, one line per value of `series`.
     pub fn chart(&self, x: &str, y: &str, series: &[String]) -> Result<LineChart> {
         let param = |name: &str| {
-            self.parameters.iter().position(|p| p == name).ok_or_else(|| {
-                Error::Input(format!(
-                    "'{name}' is not a parameter of the sweep ({})",
-                    self.parameters.join(", ")
-                ))
-            })
+            self.parameters
+                .iter()
+                .position(|p| p == name)
+                .ok_or_else(|| {
+                    Error::Input(format!(
+                        "'{name}' is not a parameter of the sweep ({})",
+                        self.parameters.join(", ")
+                    ))
+                })
         };
         let xi = param(x)?;
-        let si = series.iter().map(|s| param(s)).collect::<Result<Vec<_>>>()?;
+        let si = series
+            .iter()
+            .map(|s| param(s))
+            .collect::<Result<Vec<_>>>()?;
         let yi = self.outputs.iter().position(|o| o == y).ok_or_else(|| {
             Error::Input(format!(
                 "'{y}' is not in the summaries (collected.csv lists them all)"
             ))
         })?;
         let number = |text: &str, what: &str, id: &str| {
-            text.parse::<f64>().map_err(|_| {
-                Error::Input(format!("{id}: {what} = '{text}' is not a number"))
-            })
+            text.parse::<f64>()
+                .map_err(|_| Error::Input(format!("{id}: {what} = '{text}' is not a number")))
         };
         let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
         for (id, params, values) in &self.rows {
@@ -198,7 +203,12 @@ pub fn run(dir: &Path, spec: &ChartSpec) -> Result<Vec<PathBuf>> {
         None => collected.parameters[0].clone(),
     };
     let series: Vec<String> = if spec.series.is_empty() {
-        collected.parameters.iter().filter(|p| **p != x).cloned().collect()
+        collected
+            .parameters
+            .iter()
+            .filter(|p| **p != x)
+            .cloned()
+            .collect()
     } else {
         spec.series.clone()
     };
@@ -211,7 +221,13 @@ pub fn run(dir: &Path, spec: &ChartSpec) -> Result<Vec<PathBuf>> {
         let chart = collected.chart(&x, y, &series)?;
         let file: String = format!("chart_{y}_vs_{x}")
             .chars()
-            .map(|c| if c.is_alphanumeric() || c == '_' { c } else { '_' })
+            .map(|c| {
+                if c.is_alphanumeric() || c == '_' {
+                    c
+                } else {
+                    '_'
+                }
+            })
             .collect();
         let svg = dir.join(format!("{file}.svg"));
         chart.write(&svg)?;

@@ -23,7 +23,10 @@ pub fn run(sweep: &Sweep, jobs: usize, progress: bool) -> Result<()> {
         }
         let mut finished = None;
         for (k, (_, child)) in running.iter_mut().enumerate() {
-            if let Some(status) = child.try_wait().map_err(|e| Error::Input(format!("sweep: {e}")))? {
+            if let Some(status) = child
+                .try_wait()
+                .map_err(|e| Error::Input(format!("sweep: {e}")))?
+            {
                 finished = Some((k, status));
                 break;
             }

@@ -65,7 +65,14 @@ impl Sweep {
     /// Id of run `i`: `run_000`, `run_001`, ... (wide enough for every row, so that ids
     /// sort in row order).
     pub fn id(&self, i: usize) -> String {
-        let width = self.table.rows.len().saturating_sub(1).to_string().len().max(3);
+        let width = self
+            .table
+            .rows
+            .len()
+            .saturating_sub(1)
+            .to_string()
+            .len()
+            .max(3);
         format!("run_{i:0width$}")
     }
 

@@ -32,7 +32,10 @@ impl Table {
             .ok_or_else(|| Error::Input(format!("{file}: the table has no header line")))?;
         let columns = split(header, file, header_line)?;
         for (i, name) in columns.iter().enumerate() {
-            let identifier = name.chars().next().is_some_and(|c| c.is_alphabetic() || c == '_')
+            let identifier = name
+                .chars()
+                .next()
+                .is_some_and(|c| c.is_alphabetic() || c == '_')
                 && name.chars().all(|c| c.is_alphanumeric() || c == '_');
             if !identifier {
                 return Err(Error::Input(format!(

@@ -68,7 +68,11 @@ impl Catalogue {
 /// A type as Rhai names it to a script writer: registered types by their script names,
 /// `Result<T, _>` as `T`, Rust's paths dropped (`alloc::vec::Vec<Dynamic>` is an `array`).
 fn display_type(engine: &Engine, rust: &str) -> String {
-    let t = rust.trim().trim_start_matches("&mut ").trim_start_matches('&').trim();
+    let t = rust
+        .trim()
+        .trim_start_matches("&mut ")
+        .trim_start_matches('&')
+        .trim();
     let t = engine.map_type_name(t);
     if let Some(inner) = t
         .strip_prefix("core::result::Result<")
@@ -79,8 +83,12 @@ fn display_type(engine: &Engine, rust: &str) -> String {
     }
     match t {
         "()" => String::new(),
-        "str" | "String" | "alloc::string::String" | "rhai::ImmutableString"
-        | "ImmutableString" | "string" => "string".into(),
+        "str"
+        | "String"
+        | "alloc::string::String"
+        | "rhai::ImmutableString"
+        | "ImmutableString"
+        | "string" => "string".into(),
         "i64" | "int" => "int".into(),
         "f64" | "float" => "float".into(),
         _ if t.contains("Vec<") || t == "Array" => "array".into(),
@@ -103,7 +111,10 @@ fn parse(signature: &str, types: &dyn Fn(&str) -> String) -> Option<Function> {
         Some(p) => (p, true),
         None => (raw_name, false),
     };
-    let identifier = name.chars().next().is_some_and(|c| c.is_alphabetic() || c == '_')
+    let identifier = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_')
         && name.chars().all(|c| c.is_alphanumeric() || c == '_');
     if !identifier {
         return None;
@@ -212,7 +223,14 @@ mod tests {
         }
         assert!(!sim_methods.contains(&"block"));
         let free: Vec<&str> = c.free_functions().collect();
-        for f in ["block", "simulation", "tool", "cylinder", "coulomb", "bernstein"] {
+        for f in [
+            "block",
+            "simulation",
+            "tool",
+            "cylinder",
+            "coulomb",
+            "bernstein",
+        ] {
             assert!(free.contains(&f), "{f} missing");
         }
         assert!(c.signatures("tool_force").any(|f| f.params.len() == 2));

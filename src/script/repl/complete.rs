@@ -54,7 +54,11 @@ impl ReplHelper {
                 .map_or(pos, |(i, _)| i);
             let head = before[..start].trim_end();
             let found: Vec<&str> = if head == ":help" || head == ":h" {
-                self.catalogue.functions.iter().map(|f| f.name.as_str()).collect()
+                self.catalogue
+                    .functions
+                    .iter()
+                    .map(|f| f.name.as_str())
+                    .collect()
             } else if before[..start].ends_with(':') && head == ":" {
                 return (
                     start - 1,
@@ -178,24 +182,35 @@ mod tests {
         assert_eq!(complete("sim.tool_f"), (4, vec!["tool_force".to_string()]));
         let (_, all) = complete("sim.");
         assert!(all.contains(&"step".to_string()) && all.contains(&"time".to_string()));
-        assert!(!all.contains(&"n_nodes".to_string()), "a mesh property offered on sim");
+        assert!(
+            !all.contains(&"n_nodes".to_string()),
+            "a mesh property offered on sim"
+        );
         assert_eq!(complete("mesh.n_n").1, ["n_nodes"]);
     }
 
     #[test]
     fn free_functions_variables_settings_tools_and_commands() {
         let (start, c) = complete("let m = bloc");
-        assert_eq!((start, c), (8, vec!["block".to_string(), "block_lines".to_string()]));
+        assert_eq!(
+            (start, c),
+            (8, vec!["block".to_string(), "block_lines".to_string()])
+        );
         assert_eq!(complete("si").1, ["sig", "sim", "simulation"]);
         assert_eq!(
             complete("sim.settings(#{ step_control: \"adaptive\", max_sl").1,
             ["max_slip_increment"]
         );
         assert_eq!(complete("sim.settings(#{ end_").1, ["end_time"]);
-        assert_eq!(complete("sim.tool_force(\"ro"), (16, vec!["roller".to_string()]));
+        assert_eq!(
+            complete("sim.tool_force(\"ro"),
+            (16, vec!["roller".to_string()])
+        );
         assert_eq!(complete(":he"), (0, vec![":help".to_string()]));
         assert_eq!(complete(":help tool_p").1, ["tool_position"]);
         // A value after a key is not a key.
-        assert!(!complete("sim.settings(#{ end_time: inc").1.contains(&"increments".to_string()));
+        assert!(!complete("sim.settings(#{ end_time: inc")
+            .1
+            .contains(&"increments".to_string()));
     }
 }

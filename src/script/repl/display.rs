@@ -58,9 +58,17 @@ pub fn value(v: &Dynamic) -> String {
 
 /// Whether a map is an increment report (`sim.step()`, `sim.run()`, `sim.history()[i]`).
 pub fn is_report(m: &Map) -> bool {
-    ["index", "time", "dt", "iterations", "cutbacks", "residuals", "active_nodes"]
-        .iter()
-        .all(|k| m.contains_key(*k))
+    [
+        "index",
+        "time",
+        "dt",
+        "iterations",
+        "cutbacks",
+        "residuals",
+        "active_nodes",
+    ]
+    .iter()
+    .all(|k| m.contains_key(*k))
 }
 
 /// One line for an increment report: its index and time, where the tools are

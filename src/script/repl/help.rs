@@ -135,8 +135,14 @@ mod tests {
     fn one_function_with_its_signature_and_reference_rows() {
         let catalogue = Catalogue::of(&engine(&HostOptions::default(), None));
         let h = function_help(&catalogue, "tool_force");
-        assert!(h.starts_with("tool_force(Simulation, string) -> array\n"), "{h}");
-        assert!(h.contains("sim.tool_force(name): total force the body exerts on the tool"), "{h}");
+        assert!(
+            h.starts_with("tool_force(Simulation, string) -> array\n"),
+            "{h}"
+        );
+        assert!(
+            h.contains("sim.tool_force(name): total force the body exerts on the tool"),
+            "{h}"
+        );
         let b = function_help(&catalogue, "bernstein");
         assert!(b.contains("work per unit area"), "{b}");
         let m = function_help(&catalogue, "n_nodes");

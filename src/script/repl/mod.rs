@@ -161,7 +161,12 @@ fn session(engine: &Engine, scope: &Scope, host: &HostOptions) -> complete::Sess
     complete::Session {
         variables: scope
             .iter_raw()
-            .map(|(name, _, v)| (name.to_string(), engine.map_type_name(v.type_name()).to_string()))
+            .map(|(name, _, v)| {
+                (
+                    name.to_string(),
+                    engine.map_type_name(v.type_name()).to_string(),
+                )
+            })
             .collect(),
         tools: host.simulations.tool_names(),
     }
@@ -217,11 +222,26 @@ mod tests {
     #[test]
     fn open_statements_continue_and_errors_do_not() {
         let engine = engine(&HostOptions::default(), None);
-        for open in ["let x = 1 +", "let a = [1, 2,", "if true {", "fn f(x) {\n  x +", "print(\"a\""] {
+        for open in [
+            "let x = 1 +",
+            "let a = [1, 2,",
+            "if true {",
+            "fn f(x) {\n  x +",
+            "print(\"a\"",
+        ] {
             assert!(is_incomplete(&engine, open), "{open:?} should continue");
         }
-        for done in ["let x = 1 + 2;", "if true { 1 }", "let x = 1 +\n2;", "let x = ;", "1 +* 2"] {
-            assert!(!is_incomplete(&engine, done), "{done:?} should be evaluated");
+        for done in [
+            "let x = 1 + 2;",
+            "if true { 1 }",
+            "let x = 1 +\n2;",
+            "let x = ;",
+            "1 +* 2",
+        ] {
+            assert!(
+                !is_incomplete(&engine, done),
+                "{done:?} should be evaluated"
+            );
         }
     }
 
@@ -229,8 +249,12 @@ mod tests {
     fn commands() {
         let c = catalogue::Catalogue::of(&engine(&HostOptions::default(), None));
         assert_eq!(command_line("quit", &c), None);
-        assert!(command_line("foo", &c).unwrap().starts_with("unknown command ':foo'"));
+        assert!(command_line("foo", &c)
+            .unwrap()
+            .starts_with("unknown command ':foo'"));
         assert!(command_line("help", &c).unwrap().contains(":help NAME"));
-        assert!(command_line("help step", &c).unwrap().starts_with("step(Simulation) -> map"));
+        assert!(command_line("help step", &c)
+            .unwrap()
+            .starts_with("step(Simulation) -> map"));
     }
 }
