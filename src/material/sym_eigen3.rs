@@ -42,12 +42,14 @@ pub fn sym_eigen3(a: &Mat3) -> ([f64; 3], Mat3) {
                 continue;
             }
             let tau = (m[q][q] - m[p][p]) / (2.0 * apq);
-            let t = if tau >= 0.0 {
-                1.0 / (tau + tau.hypot(1.0))
+            // sqrt(1 + τ²) rather than libm's hypot (several times slower); beyond 1e150,
+            // where τ² would overflow, t = 1/(2τ) to round-off.
+            let t = if tau.abs() > 1e150 {
+                0.5 / tau
             } else {
-                -1.0 / (-tau + tau.hypot(1.0))
+                tau.signum() / (tau.abs() + (1.0 + tau * tau).sqrt())
             };
-            let c = 1.0 / t.hypot(1.0);
+            let c = 1.0 / (1.0 + t * t).sqrt();
             let s = t * c;
             m[p][p] -= t * apq;
             m[q][q] += t * apq;
