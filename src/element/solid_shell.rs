@@ -76,7 +76,7 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SymmetricEigen};
 
-use super::hex8::{jacobian, shape_derivatives, DOFS, NODES};
+use super::hex8::{jacobian, nodes_array, response_through_into, shape_derivatives, DOFS, NODES};
 use super::{prefix, Element, ElementResponse};
 use crate::geometry::{Mat3, Vec3};
 use crate::material::{
@@ -643,11 +643,6 @@ impl SolidShell {
     }
 }
 
-fn nodes(what: &str, v: &[Vec3]) -> Result<[Vec3; NODES]> {
-    super::hex8::check_len(what, v.len(), NODES)?;
-    Ok(std::array::from_fn(|a| v[a]))
-}
-
 impl Element<DOFS> for SolidShell {
     fn node_count(&self) -> usize {
         NODES
@@ -665,18 +660,7 @@ impl Element<DOFS> for SolidShell {
         trial: &mut [PointState],
         material: &dyn Material,
     ) -> Result<ElementResponse<DOFS>> {
-        let mut force = nalgebra::SVector::<f64, DOFS>::zeros();
-        let mut stiffness = SMatrix::<f64, DOFS, DOFS>::zeros();
-        self.evaluate_into(
-            ref_coords,
-            u,
-            committed,
-            trial,
-            material,
-            force.as_mut_slice(),
-            Some(stiffness.as_mut_slice()),
-        )?;
-        Ok(ElementResponse { force, stiffness })
+        response_through_into(self, ref_coords, u, committed, trial, material)
     }
 
     fn evaluate_into(
@@ -694,8 +678,8 @@ impl Element<DOFS> for SolidShell {
             super::hex8::check_len("stiffness", k.len(), DOFS * DOFS)?;
         }
         self.check(committed, trial)?;
-        let x = nodes("ref_coords", ref_coords)?;
-        let u = nodes("u", u)?;
+        let x = nodes_array("ref_coords", ref_coords)?;
+        let u = nodes_array("u", u)?;
         let points = self.points(&x, &u)?;
         let ne = self.modes();
         let mut alpha: Vec<f64> = committed[0].enhanced[..ne].to_vec();
@@ -789,7 +773,7 @@ impl Element<DOFS> for SolidShell {
     }
 
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>> {
-        let x = nodes("ref_coords", ref_coords)?;
+        let x = nodes_array("ref_coords", ref_coords)?;
         let (zeta, wz) = thickness_rule(self.thickness_points);
         let mut out = Vec::with_capacity(self.point_count());
         for (k, z) in zeta.iter().enumerate() {
