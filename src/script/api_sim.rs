@@ -1376,3 +1376,34 @@ fn rollback(s: &mut ScriptSim, n: usize) -> ScriptResult<f64> {
     }
     Ok(t)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings_error(key: &str) -> String {
+        let mut knobs = Knobs {
+            frames: FrameKnobs::default(),
+            checkpoint_every: 0,
+            max_increments: usize::MAX,
+        };
+        let mut spec = Map::new();
+        spec.insert(key.into(), Dynamic::UNIT);
+        match apply_settings(&mut SolverSettings::default(), &mut knobs, &spec) {
+            Ok(()) => String::new(),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// `SETTING_KEYS` (the error message's and the REPL's list) and the keys
+    /// `apply_settings` reads are kept by hand side by side: every listed key must be one it
+    /// knows (a unit value is refused by that key's own check, never as an unknown setting).
+    #[test]
+    fn every_listed_setting_key_is_read() {
+        assert!(settings_error("no_such_key").contains("unknown setting"));
+        for key in SETTING_KEYS {
+            let e = settings_error(key);
+            assert!(!e.contains("unknown setting"), "{key}: {e}");
+        }
+    }
+}
