@@ -191,13 +191,16 @@ impl PointKernel<'_> {
                 }
             }
         }
-        // Z = Bᵀ 𝔸 (24 x 9), B = ∂F/∂u: column (a, k) is e_k ⊗ b_a.
-        let mut z = [[0.0; 9]; DOFS];
+        // Z = Bᵀ 𝔸 (24 x 9), B = ∂F/∂u: column (a, k) is e_k ⊗ b_a. Stored transposed
+        // (`zt[col][row]`), so that the loops over the 24 rows of a stiffness column below
+        // run over contiguous memory and vectorise.
+        let mut zt = [[0.0; DOFS]; 9];
         for a in 0..NODES {
             for kk in 0..3 {
                 let row = &a9[3 * kk..3 * kk + 3];
-                for (col, out) in z[3 * a + kk].iter_mut().enumerate() {
-                    *out = b[a][0] * row[0][col] + b[a][1] * row[1][col] + b[a][2] * row[2][col];
+                for (col, out) in zt.iter_mut().enumerate() {
+                    out[3 * a + kk] =
+                        b[a][0] * row[0][col] + b[a][1] * row[1][col] + b[a][2] * row[2][col];
                 }
             }
         }
@@ -206,10 +209,10 @@ impl PointKernel<'_> {
             for c in 0..NODES {
                 for l in 0..3 {
                     let col = &mut k[(3 * c + l) * DOFS..(3 * c + l + 1) * DOFS];
-                    for (out, zr) in col.iter_mut().zip(&z) {
-                        let bb =
-                            zr[3 * l] * b[c][0] + zr[3 * l + 1] * b[c][1] + zr[3 * l + 2] * b[c][2];
-                        *out += r2dv * bb;
+                    let (z0, z1, z2) = (&zt[3 * l], &zt[3 * l + 1], &zt[3 * l + 2]);
+                    for i in 0..DOFS {
+                        let bb = z0[i] * b[c][0] + z1[i] * b[c][1] + z2[i] * b[c][2];
+                        col[i] += r2dv * bb;
                     }
                 }
             }
@@ -235,23 +238,27 @@ impl PointKernel<'_> {
         });
         let h = r * pf / 3.0 * dv;
         let (g, g0) = (self.g, self.g0);
+        // The H term of entry (i, j) = ((a, kk), (c, l)) is `h g_a,l g_c,kk - h g⁰_a,l g⁰_c,kk`:
+        // per column, two products of 24-vectors, `hg[l][i] = h g_a,l` and
+        // `gc[c][i] = g_c,kk` (the same products in the same order as entry by entry).
+        let hg: [[f64; DOFS]; 3] = std::array::from_fn(|l| std::array::from_fn(|i| h * g[i / 3][l]));
+        let hg0: [[f64; DOFS]; 3] =
+            std::array::from_fn(|l| std::array::from_fn(|i| h * g0[i / 3][l]));
         for c in 0..NODES {
+            let gc: [f64; DOFS] = std::array::from_fn(|i| g[c][i % 3]);
+            let g0c: [f64; DOFS] = std::array::from_fn(|i| g0[c][i % 3]);
             for l in 0..3 {
                 let j = 3 * c + l;
                 let col = &mut k[j * DOFS..(j + 1) * DOFS];
                 let (qj, bj) = (q[j], beta[j]);
-                for a in 0..NODES {
-                    let (gal, g0al) = (h * g[a][l], h * g0[a][l]);
-                    for kk in 0..3 {
-                        let i = 3 * a + kk;
-                        let zr = &z[i];
-                        let bb =
-                            zr[3 * l] * b[c][0] + zr[3 * l + 1] * b[c][1] + zr[3 * l + 2] * b[c][2];
-                        col[i] += r2dv * bb
-                            + alpha[i] * qj
-                            + q[i] * bj
-                            + (gal * g[c][kk] - g0al * g0[c][kk]);
-                    }
+                let (z0, z1, z2) = (&zt[3 * l], &zt[3 * l + 1], &zt[3 * l + 2]);
+                let (hgl, hg0l) = (&hg[l], &hg0[l]);
+                for i in 0..DOFS {
+                    let bb = z0[i] * b[c][0] + z1[i] * b[c][1] + z2[i] * b[c][2];
+                    col[i] += r2dv * bb
+                        + alpha[i] * qj
+                        + q[i] * bj
+                        + (hgl[i] * gc[i] - hg0l[i] * g0c[i]);
                 }
             }
         }

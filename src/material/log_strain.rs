@@ -119,27 +119,7 @@ impl LogStrain {
                 "right Cauchy-Green tensor with eigenvalues {lambda:?} (inverted material)"
             )));
         }
-        let f1 = std::array::from_fn(|i| std::array::from_fn(|j| first(lambda[i], lambda[j])));
-        // f[a, b, c] is symmetric (`second` sorts its arguments, so bit for bit): the ten
-        // index multisets, each computed once.
-        let mut f2 = [[[0.0; 3]; 3]; 3];
-        for i in 0..3 {
-            for k in i..3 {
-                for j in k..3 {
-                    let v = second(lambda[i], lambda[k], lambda[j]);
-                    for [a, b, c] in [
-                        [i, k, j],
-                        [i, j, k],
-                        [k, i, j],
-                        [k, j, i],
-                        [j, i, k],
-                        [j, k, i],
-                    ] {
-                        f2[a][b][c] = v;
-                    }
-                }
-            }
-        }
+        let (f1, f2) = divided_differences(&lambda);
         let basis = std::array::from_fn(|m| {
             let mut e = Voigt::zeros();
             e[m] = 1.0;
@@ -188,22 +168,28 @@ impl LogStrain {
         let gamma: [[[f64; 3]; 3]; 3] = std::array::from_fn(|i| {
             std::array::from_fn(|k| std::array::from_fn(|j| self.f2[i][k][j] * tt[(i, j)]))
         });
-        type Pair = ([[f64; 3]; 3], [[f64; 3]; 3]);
-        let uv: [Pair; 6] = std::array::from_fn(|n| {
+        // Filled in place (an array of returned pairs was copied whole: a tenth of the
+        // samples of this function).
+        let mut u = [[[0.0; 3]; 3]; 6];
+        let mut v = [[[0.0; 3]; 3]; 6];
+        for n in 0..6 {
             let k = &self.basis[n];
-            let u = std::array::from_fn(|i| {
-                std::array::from_fn(|kk| (0..3).map(|j| gamma[i][kk][j] * k[(kk, j)]).sum())
-            });
-            let v = std::array::from_fn(|kk| {
-                std::array::from_fn(|j| (0..3).map(|i| gamma[i][kk][j] * k[(i, kk)]).sum())
-            });
-            (u, v)
-        });
+            for i in 0..3 {
+                for kk in 0..3 {
+                    u[n][i][kk] = (0..3).map(|j| gamma[i][kk][j] * k[(kk, j)]).sum();
+                }
+            }
+            for kk in 0..3 {
+                for j in 0..3 {
+                    v[n][kk][j] = (0..3).map(|i| gamma[i][kk][j] * k[(i, kk)]).sum();
+                }
+            }
+        }
         let mut l = Tangent::zeros();
         for m in 0..6 {
             let h = &self.basis[m];
             for n in m..6 {
-                let (u, v) = &uv[n];
+                let (u, v) = (&u[n], &v[n]);
                 let mut sum = 0.0;
                 for a in 0..3 {
                     for b in 0..3 {
@@ -295,6 +281,64 @@ fn finish(trial: &mut PointState, f: &Mat3, j: f64, pk2: &Voigt) {
     trial.stress = stress_from_tensor(&(f * stress_to_tensor(pk2) * f.transpose() / j));
 }
 
+/// The first divided differences `f[λ_i, λ_j]` (all nine ordered pairs) and the second
+/// `f[λ_i, λ_k, λ_j]` (indexed `[i][k][j]`) of `f = ½ ln`. The second is symmetric and
+/// `second` evaluates it on its sorted arguments `lo <= mid <= hi` from `f[mid, hi]` and
+/// `f[lo, mid]`: so with the eigenvalues sorted once, the first differences of the sorted
+/// pairs serve every one of the ten index multisets, and the nine ordered pairs need only
+/// the three reversed ones more: 6 `log1p` instead of 26, the same values bit for bit.
+fn divided_differences(lambda: &[f64; 3]) -> ([[f64; 3]; 3], [[[f64; 3]; 3]; 3]) {
+    let mut order = [0, 1, 2];
+    order.sort_by(|&x, &y| lambda[x].total_cmp(&lambda[y]));
+    let mut rank = [0; 3];
+    for (r, &i) in order.iter().enumerate() {
+        rank[i] = r;
+    }
+    let s = order.map(|i| lambda[i]);
+    // f[s_a, s_b] for a <= b (ascending arguments, as `second` forms them).
+    let mut sorted_first = [[0.0; 3]; 3];
+    for a in 0..3 {
+        for b in a..3 {
+            sorted_first[a][b] = first(s[a], s[b]);
+        }
+    }
+    let f1 = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            if rank[i] <= rank[j] {
+                sorted_first[rank[i]][rank[j]]
+            } else {
+                first(lambda[i], lambda[j])
+            }
+        })
+    });
+    let mut f2 = [[[0.0; 3]; 3]; 3];
+    for i in 0..3 {
+        for k in i..3 {
+            for j in k..3 {
+                let mut r = [rank[i], rank[k], rank[j]];
+                r.sort_unstable();
+                let [lo, mid, hi] = r.map(|x| s[x]);
+                let v = if hi - lo > TAYLOR_SPREAD * hi {
+                    (sorted_first[r[1]][r[2]] - sorted_first[r[0]][r[1]]) / (hi - lo)
+                } else {
+                    second_taylor(lo, mid, hi)
+                };
+                for [a, b, c] in [
+                    [i, k, j],
+                    [i, j, k],
+                    [k, i, j],
+                    [k, j, i],
+                    [j, i, k],
+                    [j, k, i],
+                ] {
+                    f2[a][b][c] = v;
+                }
+            }
+        }
+    }
+    (f1, f2)
+}
+
 /// `f[a, b]` for `f = ½ ln`, stable for `a ≈ b`.
 fn first(a: f64, b: f64) -> f64 {
     let d = (a - b) / b;
@@ -302,7 +346,9 @@ fn first(a: f64, b: f64) -> f64 {
     0.5 * ratio / b
 }
 
-/// `f[a, b, c]` for `f = ½ ln` (symmetric in its arguments), stable for near-equal ones.
+/// `f[a, b, c]` for `f = ½ ln` (symmetric in its arguments), stable for near-equal ones:
+/// the definition that [`divided_differences`] evaluates with shared first differences.
+#[cfg(test)]
 fn second(a: f64, b: f64, c: f64) -> f64 {
     let mut v = [a, b, c];
     v.sort_by(|x, y| x.total_cmp(y));
@@ -341,6 +387,35 @@ mod tests {
             Mat3::from_diagonal(&[1.0, 1.0 + 2e-4, 1.0 - 1e-4].into()),
             Mat3::identity(),
         ]
+    }
+
+    /// The shared evaluation of the divided differences gives, bit for bit, the direct
+    /// `first` and `second` of every index combination: distinct, two equal (in every
+    /// position), three equal, nearly equal (the Taylor branch) and in every order.
+    #[test]
+    fn shared_divided_differences_equal_the_direct_ones_bit_for_bit() {
+        let triples = [
+            [1.3, 0.7, 1.1],
+            [0.7, 1.3, 1.3],
+            [1.3, 0.7, 1.3],
+            [1.3, 1.3, 0.7],
+            [1.0, 1.0, 1.0],
+            [1.0 + 1e-9, 1.0 - 2e-9, 1.0],
+            [2.0, 2.0 + 1e-6, 0.5],
+            [0.5, 2.0, 2.0 + 1e-6],
+        ];
+        for lambda in triples {
+            let (f1, f2) = divided_differences(&lambda);
+            for i in 0..3 {
+                for j in 0..3 {
+                    assert_eq!(f1[i][j].to_bits(), first(lambda[i], lambda[j]).to_bits());
+                    for k in 0..3 {
+                        let direct = second(lambda[i], lambda[k], lambda[j]);
+                        assert_eq!(f2[i][k][j].to_bits(), direct.to_bits(), "{lambda:?}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
