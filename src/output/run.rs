@@ -474,6 +474,7 @@ impl RunOutput {
             "evaluations": {
                 "full": sim.phase_times.full_evaluations,
                 "residual_only": sim.phase_times.residual_evaluations,
+                "jacobian_completions": sim.phase_times.jacobian_completions,
             },
             "kinematics": settings.kinematics.name(),
             "nodes": sim.model.mesh.nodes.len(),

@@ -240,6 +240,9 @@ pub struct PhaseTimes {
     pub full_evaluations: usize,
     /// Residual-only evaluations ([`IncrementContext::evaluate_residual`]).
     pub residual_evaluations: usize,
+    /// Residual-only evaluations given their Jacobian afterwards
+    /// ([`IncrementContext::complete`]: element tangents and assembly, no contact pass).
+    pub jacobian_completions: usize,
 }
 
 impl PhaseTimes {
@@ -250,6 +253,7 @@ impl PhaseTimes {
         self.factorization_and_solve += other.factorization_and_solve;
         self.full_evaluations += other.full_evaluations;
         self.residual_evaluations += other.residual_evaluations;
+        self.jacobian_completions += other.jacobian_completions;
     }
 }
 
@@ -313,6 +317,103 @@ impl IncrementContext<'_> {
     /// is evaluated again in full before Newton solves with it.
     pub fn evaluate_residual(&self, x: &[f64], times: &mut PhaseTimes) -> Result<Evaluation> {
         self.evaluate_with(x, times, false)
+    }
+
+    /// The Jacobian of a residual-only evaluation `eval` at the same `x`, so that an
+    /// accepted line-search cut needs no second evaluation: the element tangents (the
+    /// kernel run again with its tangent: the same point states) and their assembly, and
+    /// the contact blocks from the operator outputs `eval` already holds (no projection,
+    /// no operator). The result equals [`Self::evaluate`] at `x`, bit for bit: the same
+    /// additions in the same order. A model with a force-controlled tool is evaluated
+    /// again in full (its rows are few and placed by search); an `eval` that already has
+    /// its Jacobian is returned as it is.
+    pub fn complete(
+        &self,
+        x: &[f64],
+        eval: Evaluation,
+        times: &mut PhaseTimes,
+    ) -> Result<Evaluation> {
+        if eval.has_jacobian() {
+            return Ok(eval);
+        }
+        if self.dofs.tool_offset.iter().any(Option::is_some) {
+            return self.evaluate(x, times);
+        }
+        times.jacobian_completions += 1;
+        let model = self.model;
+        let t0 = Instant::now();
+        let threads = element_threads(model.settings.threads);
+        let slots = self.dofs.slots(model, &self.pattern);
+        let mut trial_points = self.committed_points.to_vec();
+        let elements = evaluate_elements(
+            model,
+            x,
+            self.committed_points,
+            &mut trial_points,
+            threads,
+            true,
+        )?;
+        let mut jac = SparseMatrix::zeros(self.pattern.clone());
+        slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
+        times.elements += t0.elapsed().as_secs_f64();
+        let t1 = Instant::now();
+        let mut unit = self.is_fixed.to_vec();
+        for (c, contact) in model.contacts.iter().enumerate() {
+            for (k, &node) in contact.candidates.iter().enumerate() {
+                let result = &eval.nodal[c][k].0;
+                let lam_dof = self.dofs.lambda_offset[c].map(|off| off + 3 * k);
+                self.add_pair_jacobian(&mut jac, &slots.contact[c][k], result, c, node, lam_dof);
+                if let Some(l) = lam_dof {
+                    for i in self.multiplier_unit_rows(result, node) {
+                        unit[l + i] = true;
+                    }
+                }
+            }
+        }
+        jac.set_unit_rows(&unit);
+        times.contact += t1.elapsed().as_secs_f64();
+        Ok(Evaluation {
+            jacobian: jac,
+            trial_points,
+            ..eval
+        })
+    }
+
+    /// The multiplier components `k` of a pair whose equation becomes `lambda_k = 0`: a
+    /// sticking candidate `node` with a prescribed displacement component `k` (see
+    /// `evaluate_with`).
+    fn multiplier_unit_rows<'b>(
+        &'b self,
+        result: &NodalContact,
+        node: usize,
+    ) -> impl Iterator<Item = usize> + 'b {
+        let stick = result.status == crate::contact::ContactStatus::Stick;
+        (0..3).filter(move |&k| stick && self.is_fixed[3 * node + k])
+    }
+
+    /// Adds one contact pair's blocks (operator output `result` of candidate `node` of
+    /// tool `c`, multipliers at `lam_dof`) to the Jacobian at their slots.
+    fn add_pair_jacobian(
+        &self,
+        jac: &mut SparseMatrix,
+        pair_slots: &super::slots::ContactSlots,
+        result: &NodalContact,
+        c: usize,
+        node: usize,
+        lam_dof: Option<usize>,
+    ) {
+        for (ij, &slot) in pair_slots[0].iter().enumerate() {
+            jac.values[slot] += result.equi_x[(ij / 3, ij % 3)];
+        }
+        if let Some(l) = lam_dof {
+            for ij in 0..9 {
+                let (i, j) = (ij / 3, ij % 3);
+                jac.values[pair_slots[1][ij]] += result.equi_lambda[(i, j)];
+                jac.values[pair_slots[2][ij]] += result.suppl_x[(i, j)];
+                jac.values[pair_slots[3][ij]] += result.suppl_lambda[(i, j)];
+            }
+            force_control::add_node_column(jac, self.model, self.dofs, c, node, l, result);
+        }
     }
 
     fn evaluate_with(
@@ -434,38 +535,21 @@ impl IncrementContext<'_> {
                 for i in 0..3 {
                     residual[3 * node + i] += result.f_equi[i];
                 }
-                if with_jacobian {
-                    for (ij, &slot) in pair_slots[0].iter().enumerate() {
-                        jac.values[slot] += result.equi_x[(ij / 3, ij % 3)];
-                    }
-                }
                 if let Some(l) = lam_dof {
                     // A sticking node with a prescribed displacement component k: its
                     // tangential force along k and the support reaction are one and the same
                     // unknown (the Jacobian is singular), so the support carries it:
                     // lambda_k = 0. This is exact on symmetry planes and in plane strain,
                     // where the tool normal lies in the constrained plane.
-                    if result.status == crate::contact::ContactStatus::Stick {
-                        for k in 0..3 {
-                            if self.is_fixed[3 * node + k] {
-                                unit_rows.push((l + k, lambda[k]));
-                            }
-                        }
+                    for k in self.multiplier_unit_rows(&result, node) {
+                        unit_rows.push((l + k, lambda[k]));
                     }
                     for i in 0..3 {
                         residual[l + i] = result.f_suppl[i];
                     }
-                    if with_jacobian {
-                        for ij in 0..9 {
-                            let (i, j) = (ij / 3, ij % 3);
-                            jac.values[pair_slots[1][ij]] += result.equi_lambda[(i, j)];
-                            jac.values[pair_slots[2][ij]] += result.suppl_x[(i, j)];
-                            jac.values[pair_slots[3][ij]] += result.suppl_lambda[(i, j)];
-                        }
-                        force_control::add_node_column(
-                            &mut jac, model, self.dofs, c, node, l, &result,
-                        );
-                    }
+                }
+                if with_jacobian {
+                    self.add_pair_jacobian(&mut jac, pair_slots, &result, c, node, lam_dof);
                 }
                 list.push((result, proj));
             }
@@ -642,7 +726,9 @@ mod tests {
     /// A residual-only evaluation gives, bit for bit, everything a full one gives but the
     /// Jacobian (residual, forces, support forces, point states, contact output): so the
     /// line search, which judges a trial by these alone, takes the same decisions with it.
-    /// The full evaluation's Jacobian is complete, the residual-only one's empty.
+    /// The full evaluation's Jacobian is complete, the residual-only one's empty, and
+    /// completing the latter (`complete`, what an accepted line-search cut gets) gives the
+    /// former's, bit for bit.
     #[test]
     fn residual_only_evaluation_equals_the_full_one_but_the_jacobian() {
         for force_controlled in [false, true] {
@@ -684,8 +770,26 @@ mod tests {
                 forced: None,
             };
             let mut times = PhaseTimes::default();
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             let full = ctx.evaluate(&x, &mut times).unwrap();
             let residual_only = ctx.evaluate_residual(&x, &mut times).unwrap();
+            // Completed with its Jacobian: the full evaluation, bit for bit (the
+            // force-controlled model is evaluated again in full, the other completed
+            // without a contact pass).
+            let completions = times.jacobian_completions;
+            let completed = ctx
+                .complete(&x, ctx.evaluate_residual(&x, &mut times).unwrap(), &mut times)
+                .unwrap();
+            assert_eq!(
+                times.jacobian_completions,
+                completions + usize::from(!force_controlled)
+            );
+            assert_eq!(
+                bits(&completed.jacobian.values),
+                bits(&full.jacobian.values)
+            );
+            assert_eq!(bits(&completed.residual), bits(&full.residual));
+            assert_eq!(completed.trial_points, full.trial_points);
             let statuses: Vec<ContactStatus> =
                 full.nodal[0].iter().map(|(r, _)| r.status).collect();
             assert!(
@@ -697,7 +801,6 @@ mod tests {
                 "the strip must yield"
             );
             assert!(full.has_jacobian() && !residual_only.has_jacobian());
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&full.residual), bits(&residual_only.residual));
             assert_eq!(bits(&full.f_int), bits(&residual_only.f_int));
             assert_eq!(bits(&full.f_ext), bits(&residual_only.f_ext));

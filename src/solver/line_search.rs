@@ -40,7 +40,8 @@ impl Simulation {
         for cut in 0..=LINE_SEARCH_CUTS {
             let xn = trial_x(alpha);
             // The full step, usually accepted, is evaluated whole; a cut only for its
-            // residual, and whole once accepted.
+            // residual, and given its Jacobian once accepted (`complete`: the element
+            // tangents, no second contact pass).
             let evaluated = if cut == 0 {
                 ctx.evaluate(&xn, times)
             } else {
@@ -50,11 +51,7 @@ impl Simulation {
                 Ok(e) => {
                     let m = self.residual_record(&e, weights).1;
                     if m.is_finite() && m <= (1.0 - 1e-4 * alpha) * merit0 {
-                        let e = if e.has_jacobian() {
-                            e
-                        } else {
-                            ctx.evaluate(&xn, times)?
-                        };
+                        let e = ctx.complete(&xn, e, times)?;
                         return Ok((xn, e, cut));
                     }
                     if cut == 0 && alpha0 == 1.0 && m.is_finite() && accept_full(&e)? {
@@ -70,11 +67,7 @@ impl Simulation {
         }
         match (best, last_err) {
             (Some((_, xn, e)), _) => {
-                let e = if e.has_jacobian() {
-                    e
-                } else {
-                    ctx.evaluate(&xn, times)?
-                };
+                let e = ctx.complete(&xn, e, times)?;
                 Ok((xn, e, LINE_SEARCH_CUTS))
             }
             (None, Some(err)) => Err(err),
