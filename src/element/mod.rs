@@ -23,6 +23,8 @@ pub mod hex8_fbar;
 #[doc(hidden)]
 pub mod hex8_fbar_reference;
 pub mod solid_shell;
+#[doc(hidden)]
+pub mod solid_shell_reference;
 
 pub use hex8::Hex8;
 pub use hex8_fbar::Hex8FBar;

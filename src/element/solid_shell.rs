@@ -74,7 +74,7 @@
 //! iteration: one material update (plus one 3 x 3 eigen-decomposition under finite
 //! strain); per point once: `Bᵀ ℂ B`, ~4.3k multiplications.
 
-use nalgebra::{DMatrix, DVector, SMatrix, SymmetricEigen};
+use nalgebra::{SMatrix, SVector};
 
 use super::hex8::{jacobian, nodes_array, response_through_into, shape_derivatives, DOFS, NODES};
 use super::{prefix, Element, ElementResponse};
@@ -92,13 +92,13 @@ pub const MAX_THICKNESS_POINTS: usize = 12;
 pub const DEFAULT_THICKNESS_POINTS: usize = 5;
 
 /// Covariant strain components in Voigt order: `(α, β)` of `xx, yy, zz, xy, yz, zx`.
-const COMPONENTS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)];
+pub(super) const COMPONENTS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)];
 
 /// In-plane Gauss abscissa `1/√3`.
 const GAUSS: f64 = 0.577_350_269_189_625_8;
 
 /// Most local Newton iterations for the EAS parameters.
-const MAX_LOCAL_ITERATIONS: usize = 30;
+pub(super) const MAX_LOCAL_ITERATIONS: usize = 30;
 
 /// The solid-shell hexahedron; see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -141,6 +141,34 @@ impl ElementKind {
                 "must be \"hexahedron\" or \"solid_shell\"",
             )),
         }
+    }
+}
+
+/// The enhanced parameters of an increment's last evaluation, to start the next
+/// evaluation's local iterations from (the solid-shell reads them from the trial states it
+/// is given, [`SolidShell`]'s `evaluate_into`): near the converged values, where the
+/// committed ones are an increment away. The converged parameters are the same either way,
+/// to the local tolerance. One per Newton attempt (a cut-back starts afresh).
+#[derive(Debug, Default)]
+pub struct WarmStart(std::sync::Mutex<Vec<[f64; ENHANCED_PARAMETERS]>>);
+
+impl WarmStart {
+    /// Puts the kept parameters into `trial` (a copy of the committed states), when there
+    /// are as many.
+    pub fn seed(&self, trial: &mut [PointState]) {
+        let kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if kept.len() == trial.len() {
+            for (state, alpha) in trial.iter_mut().zip(kept.iter()) {
+                state.enhanced = *alpha;
+            }
+        }
+    }
+
+    /// Keeps the parameters of an evaluation's trial states.
+    pub fn keep(&self, trial: &[PointState]) {
+        let mut kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        kept.clear();
+        kept.extend(trial.iter().map(|s| s.enhanced));
     }
 }
 
@@ -313,16 +341,16 @@ fn legendre(n: usize, z: f64) -> (f64, f64) {
 }
 
 /// In-plane natural coordinates of point `q` (corner order 0-3).
-fn in_plane(q: usize) -> (f64, f64) {
+pub(super) fn in_plane(q: usize) -> (f64, f64) {
     let c = crate::mesh::HEX_CORNERS[q];
     (c[0] * GAUSS, c[1] * GAUSS)
 }
 
 /// Tying locations of one thickness level: 0-3 the in-plane points, 4-7 the corner lines
 /// (E₃₃), 8-9 `(∓1, 0)` (E₂₃), 10-11 `(0, ∓1)` (E₁₃).
-const LOCATIONS: usize = 12;
+pub(super) const LOCATIONS: usize = 12;
 
-fn location(l: usize) -> (f64, f64) {
+pub(super) fn location(l: usize) -> (f64, f64) {
     match l {
         0..=3 => in_plane(l),
         4..=7 => {
@@ -338,7 +366,7 @@ fn location(l: usize) -> (f64, f64) {
 
 /// The sampling of covariant component `c` at in-plane point `q`: `(location, weight)`
 /// pairs, `len` of them.
-fn samples(q: usize, c: usize) -> ([(usize, f64); 4], usize) {
+pub(super) fn samples(q: usize, c: usize) -> ([(usize, f64); 4], usize) {
     let (xi, eta) = in_plane(q);
     let mut s = [(0, 0.0); 4];
     match c {
@@ -366,12 +394,6 @@ fn samples(q: usize, c: usize) -> ([(usize, f64); 4], usize) {
     }
 }
 
-/// Kinematics of one tying location: natural derivatives, `J = [G_α]`, `D = [d_α]`.
-struct Location {
-    dn: [Vec3; NODES],
-    j: Mat3,
-    d: Mat3,
-}
 
 /// What one integration point keeps between the local iterations and the assembly.
 struct Point {
@@ -381,8 +403,9 @@ struct Point {
     b: SMatrix<f64, 6, DOFS>,
     /// Covariant-to-Cartesian map of engineering strain vectors.
     t: Tangent,
-    /// EAS modes (Cartesian, engineering shear), one column per parameter.
-    modes: [Voigt; ENHANCED_PARAMETERS],
+    /// EAS modes (Cartesian, engineering shear), one column per parameter (zero columns
+    /// for inactive parameters).
+    modes: Tangent,
     /// Reference volume weight.
     dv: f64,
     /// Compatible deformation gradient at the point (for the Cauchy stress and the
@@ -393,30 +416,54 @@ struct Point {
     q: usize,
 }
 
-/// `U - I` for `C = I + a` (`a = 2E`), without round-off against `I`.
-fn stretch_minus_identity(a: &Mat3) -> Result<Mat3> {
+/// Natural derivatives at the tying locations of every thickness level, kept from
+/// [`SolidShell::points`] for the geometric stiffness.
+type LevelDerivatives = [[Vec3; NODES]; LOCATIONS];
+
+/// A stretch-excess `h` with `(I + h)ᵀ(I + h) = I + a` (`a = 2E` symmetric) for the
+/// log-strain material, which depends on `C` only: `I + h` is the upper Cholesky factor of
+/// `C`, formed without round-off against `I` (`√(1 + x) - 1 = x / (1 + √(1 + x))`). Three
+/// square roots, where `U - I` needs an eigen-decomposition. Errors: `C` not positive
+/// definite (an inverted material) or not finite.
+pub(super) fn cholesky_excess(a: &Mat3) -> Result<Mat3> {
     if !a.iter().all(|v| v.is_finite()) {
         return Err(Error::NoConvergence("non-finite enhanced strain".into()));
     }
-    let eig = SymmetricEigen::new((a + a.transpose()) * 0.5);
-    let mut d = Vec3::zeros();
+    let mut h = Mat3::zeros();
+    // Row i of R = I + h: R_ii = √(C_ii - Σ_{k<i} R_ki²), R_ij = (C_ij - Σ_{k<i} R_ki R_kj) / R_ii.
     for i in 0..3 {
-        let mu = eig.eigenvalues[i];
-        if mu.is_nan() || mu <= -1.0 {
+        let mut excess = a[(i, i)];
+        for k in 0..i {
+            excess -= h[(k, i)] * h[(k, i)];
+        }
+        if excess.is_nan() || excess <= -1.0 {
             return Err(Error::NoConvergence(format!(
-                "enhanced strain with a stretch eigenvalue {} (inverted material)",
-                1.0 + mu
+                "enhanced strain with a non-positive stretch {} (inverted material)",
+                1.0 + excess
             )));
         }
-        d[i] = mu / (1.0 + (1.0 + mu).sqrt());
+        let r = (1.0 + excess).sqrt();
+        h[(i, i)] = excess / (1.0 + r);
+        for j in i + 1..3 {
+            let mut c = 0.5 * (a[(i, j)] + a[(j, i)]);
+            for k in 0..i {
+                c -= h[(k, i)] * h[(k, j)];
+            }
+            h[(i, j)] = c / r;
+        }
     }
-    let q = eig.eigenvectors;
-    Ok(q * Mat3::from_diagonal(&d) * q.transpose())
+    Ok(h)
+}
+
+/// The through-thickness rule of `n` points, computed once per `n`.
+fn cached_rule(n: usize) -> &'static (Vec<f64>, Vec<f64>) {
+    static RULES: std::sync::OnceLock<Vec<(Vec<f64>, Vec<f64>)>> = std::sync::OnceLock::new();
+    &RULES.get_or_init(|| (0..=MAX_THICKNESS_POINTS).map(thickness_rule).collect())[n]
 }
 
 impl SolidShell {
     /// Number of active EAS parameters.
-    fn modes(&self) -> usize {
+    pub(super) fn modes(&self) -> usize {
         if self.membrane_modes {
             6
         } else {
@@ -424,10 +471,15 @@ impl SolidShell {
         }
     }
 
-    /// The reference quantities and displacement strains of every point.
-    fn points(&self, x: &[Vec3; NODES], u: &[Vec3; NODES]) -> Result<Vec<Point>> {
+    /// The reference quantities and displacement strains of every point, and the natural
+    /// derivatives at the tying locations of every level.
+    fn points(
+        &self,
+        x: &[Vec3; NODES],
+        u: &[Vec3; NODES],
+    ) -> Result<(Vec<Point>, Vec<LevelDerivatives>)> {
         let n = self.thickness_points;
-        let (zeta, wz) = thickness_rule(n);
+        let (zeta, wz) = cached_rule(n);
         let centre = jacobian(x, &Vec3::zeros());
         let j0 = centre.determinant();
         let inv0 = match centre.try_inverse() {
@@ -449,13 +501,23 @@ impl SolidShell {
         let m22 = tensor_mode(contra[1] * contra[1].transpose() * (len[1] * len[1]));
         let g12 = contra[0] * contra[1].transpose() * (len[0] * len[1]);
         let m12 = tensor_mode((g12 + g12.transpose()) * 0.5);
-        // Jacobian determinants of every point, for ζ̄.
-        let dets: Vec<f64> = (0..4 * n)
-            .map(|p| {
-                let (xi, eta) = in_plane(p % 4);
-                jacobian(x, &Vec3::new(xi, eta, zeta[p / 4])).determinant()
-            })
-            .collect();
+        let mut levels = Vec::with_capacity(n);
+        let mut jacobians = Vec::with_capacity(n);
+        let mut dets = [0.0; 4 * MAX_THICKNESS_POINTS];
+        for (k, &z) in zeta.iter().enumerate() {
+            let dn: LevelDerivatives = std::array::from_fn(|l| {
+                let (xi, eta) = location(l);
+                shape_derivatives(&Vec3::new(xi, eta, z))
+            });
+            let j: [Mat3; LOCATIONS] = std::array::from_fn(|l| {
+                (0..NODES).fold(Mat3::zeros(), |m, a| m + x[a] * dn[l][a].transpose())
+            });
+            for q in 0..4 {
+                dets[4 * k + q] = j[q].determinant();
+            }
+            levels.push(dn);
+            jacobians.push(j);
+        }
         // Column means of ζ and ζ² (weights w j), so that the thickness modes have zero
         // mean along every column.
         let column_mean = |f: &dyn Fn(f64) -> f64| -> [f64; 4] {
@@ -472,16 +534,14 @@ impl SolidShell {
         let zeta2_bar = column_mean(&|z| z * z);
         let mut points = Vec::with_capacity(4 * n);
         for (k, &z) in zeta.iter().enumerate() {
-            let locations: [Location; LOCATIONS] = std::array::from_fn(|l| {
-                let (xi, eta) = location(l);
-                let dn = shape_derivatives(&Vec3::new(xi, eta, z));
-                let j = (0..NODES).fold(Mat3::zeros(), |m, a| m + x[a] * dn[a].transpose());
-                let d = (0..NODES).fold(Mat3::zeros(), |m, a| m + u[a] * dn[a].transpose());
-                Location { dn, j, d }
+            let dn = &levels[k];
+            let js = &jacobians[k];
+            let ds: [Mat3; LOCATIONS] = std::array::from_fn(|l| {
+                (0..NODES).fold(Mat3::zeros(), |m, a| m + u[a] * dn[l][a].transpose())
             });
             for q in 0..4 {
                 let p = 4 * k + q;
-                let jp = locations[q].j;
+                let jp = js[q];
                 let det = dets[p];
                 let inv = match jp.try_inverse() {
                     Some(inv) if det > 0.0 && det.is_finite() => inv,
@@ -499,9 +559,8 @@ impl SolidShell {
                     let s = if al == be { 0.5 } else { 1.0 };
                     let (list, count) = samples(q, c);
                     for &(l, phi) in &list[..count] {
-                        let loc = &locations[l];
-                        let (ga, gb) = (loc.j.column(al), loc.j.column(be));
-                        let (da, db) = (loc.d.column(al), loc.d.column(be));
+                        let (ga, gb) = (js[l].column(al), js[l].column(be));
+                        let (da, db) = (ds[l].column(al), ds[l].column(be));
                         let mut value = ga.dot(&db) + da.dot(&gb);
                         let (cur_a, cur_b) = if self.finite {
                             value += da.dot(&db);
@@ -511,33 +570,32 @@ impl SolidShell {
                         };
                         e_cov[c] += phi * s * value;
                         for a in 0..NODES {
-                            let v = (cur_b * loc.dn[a][al] + cur_a * loc.dn[a][be]) * (phi * s);
+                            let v = (cur_b * dn[l][a][al] + cur_a * dn[l][a][be]) * (phi * s);
                             for kk in 0..3 {
                                 b_cov[(c, 3 * a + kk)] += v[kk];
                             }
                         }
                     }
                 }
-                let t = Tangent::from_fn(|_, _| 0.0);
-                let t = (0..6).fold(t, |mut t, m| {
+                let mut t = Tangent::zeros();
+                for m in 0..6 {
                     let mut unit = Voigt::zeros();
                     unit[m] = 1.0;
                     let cart = inv.transpose() * strain_to_tensor(&unit) * inv;
                     t.set_column(m, &strain_from_tensor(&cart));
-                    t
-                });
+                }
                 let (xi, eta) = in_plane(q);
                 let scale = j0 / det;
-                let mut modes = [Voigt::zeros(); ENHANCED_PARAMETERS];
-                modes[0] = thickness_mode * (z - zeta_bar[q]);
-                modes[1] = thickness_mode * (z * z - zeta2_bar[q]);
+                let mut modes = Tangent::zeros();
+                modes.set_column(0, &(thickness_mode * (z - zeta_bar[q])));
+                modes.set_column(1, &(thickness_mode * (z * z - zeta2_bar[q])));
                 if self.membrane_modes {
-                    modes[2] = m11 * (scale * xi);
-                    modes[3] = m22 * (scale * eta);
-                    modes[4] = m12 * (scale * xi);
-                    modes[5] = m12 * (scale * eta);
+                    modes.set_column(2, &(m11 * (scale * xi)));
+                    modes.set_column(3, &(m22 * (scale * eta)));
+                    modes.set_column(4, &(m12 * (scale * xi)));
+                    modes.set_column(5, &(m12 * (scale * eta)));
                 }
-                let h = locations[q].d * inv;
+                let h = ds[q] * inv;
                 points.push(Point {
                     strain: t * e_cov,
                     b: t * b_cov,
@@ -549,71 +607,88 @@ impl SolidShell {
                     q,
                 });
             }
-            // The locations are needed again for the geometric stiffness: recomputed
-            // there (cheap), not kept.
         }
-        Ok(points)
+        Ok((points, levels))
     }
 
-    /// The material at point `p` with the EAS parameters `alpha`: PK2 (or small-strain)
-    /// stress and tangent; writes `trial`.
+    /// The material at `point` with the EAS parameters `alpha`: PK2 (or small-strain)
+    /// stress and tangent; writes the material's part of `trial` ([`Self::finish_point`]
+    /// completes it once `alpha` has converged).
     fn material_at(
         &self,
         point: &Point,
-        alpha: &[f64],
+        alpha: &SVector<f64, ENHANCED_PARAMETERS>,
         committed: &PointState,
         trial: &mut PointState,
         material: &dyn Material,
     ) -> Result<(Voigt, Tangent)> {
-        let mut e = point.strain;
-        for (m, a) in alpha.iter().enumerate() {
-            e += point.modes[m] * *a;
-        }
-        let (s, c) = if self.finite {
-            let h = stretch_minus_identity(&(strain_to_tensor(&e) * 2.0))?;
+        let e = point.strain + point.modes * alpha;
+        if self.finite {
+            let h = cholesky_excess(&(strain_to_tensor(&e) * 2.0))?;
             let resp = material.update_finite_displacement_gradient(&h, committed, trial)?;
-            let f = &point.f;
-            let j = f.determinant();
-            trial.stress =
-                stress_from_tensor(&(f * stress_to_tensor(&resp.pk2) * f.transpose() / j));
-            (resp.pk2, resp.tangent)
+            Ok((resp.pk2, resp.tangent))
         } else {
             let kin = Kinematics {
                 strain: e,
                 deformation_gradient: point.f,
             };
             let c = material.update(&kin, committed, trial)?;
-            (trial.stress, c)
-        };
-        trial.deformation_gradient = point.f;
-        trial.enhanced = [0.0; ENHANCED_PARAMETERS];
-        trial.enhanced[..alpha.len()].copy_from_slice(alpha);
-        Ok((s, c))
+            Ok((trial.stress, c))
+        }
     }
 
-    /// Adds the geometric stiffness `Σ_c S^c ∂²E_c/∂u²` of every point to `k`.
+    /// The output part of a converged point's `trial`: Cauchy stress (finite strain: PK2
+    /// `s` pushed forward with the compatible `F`), `F` and the enhanced parameters.
+    fn finish_point(
+        &self,
+        point: &Point,
+        s: &Voigt,
+        alpha: &SVector<f64, ENHANCED_PARAMETERS>,
+        trial: &mut PointState,
+    ) {
+        if self.finite {
+            let f = &point.f;
+            let j = f.determinant();
+            trial.stress = stress_from_tensor(&(f * stress_to_tensor(s) * f.transpose() / j));
+        }
+        trial.deformation_gradient = point.f;
+        trial.enhanced = (*alpha).into();
+    }
+
+    /// Adds the geometric stiffness `Σ_c S^c ∂²E_c/∂u²` of every point to `k`: the
+    /// covariant stresses are gathered per tying location and thickness level as
+    /// `A_loc` (3 x 3), then `g_ab += ∂N_aᵀ A_loc ∂N_b` once per location.
     fn add_geometric(
         &self,
         points: &[Point],
+        levels: &[LevelDerivatives],
         stresses: &[Voigt],
         k: &mut SMatrix<f64, DOFS, DOFS>,
     ) {
-        let (zeta, _) = thickness_rule(self.thickness_points);
-        let mut g = [[0.0; NODES]; NODES];
+        let mut gathered = vec![[Mat3::zeros(); LOCATIONS]; levels.len()];
         for (point, s) in points.iter().zip(stresses) {
             let s_cov = point.t.transpose() * s * point.dv;
-            let z = zeta[point.level];
+            let a = &mut gathered[point.level];
             for (c, &(al, be)) in COMPONENTS.iter().enumerate() {
                 let half = if al == be { 0.5 } else { 1.0 };
                 let (list, count) = samples(point.q, c);
                 for &(l, phi) in &list[..count] {
-                    let (xi, eta) = location(l);
-                    let dn = shape_derivatives(&Vec3::new(xi, eta, z));
                     let coef = s_cov[c] * phi * half;
-                    for a in 0..NODES {
-                        for b in 0..NODES {
-                            g[a][b] += coef * (dn[a][al] * dn[b][be] + dn[a][be] * dn[b][al]);
-                        }
+                    a[l][(al, be)] += coef;
+                    a[l][(be, al)] += coef;
+                }
+            }
+        }
+        let mut g = [[0.0; NODES]; NODES];
+        for (a_level, dn) in gathered.iter().zip(levels) {
+            for (a_loc, dn) in a_level.iter().zip(dn) {
+                if a_loc.iter().all(|v| *v == 0.0) {
+                    continue;
+                }
+                let adn: [Vec3; NODES] = std::array::from_fn(|b| a_loc * dn[b]);
+                for a in 0..NODES {
+                    for b in 0..NODES {
+                        g[a][b] += dn[a].dot(&adn[b]);
                     }
                 }
             }
@@ -627,7 +702,7 @@ impl SolidShell {
         }
     }
 
-    fn check(&self, committed: &[PointState], trial: &[PointState]) -> Result<()> {
+    pub(super) fn check(&self, committed: &[PointState], trial: &[PointState]) -> Result<()> {
         check_thickness_points(self.thickness_points)?;
         let np = self.point_count();
         for (what, len) in [("committed", committed.len()), ("trial", trial.len())] {
@@ -663,6 +738,10 @@ impl Element<DOFS> for SolidShell {
         response_through_into(self, ref_coords, u, committed, trial, material)
     }
 
+    /// The enhanced parameters start from those `trial` carries when they are finite (the
+    /// last iterate's, if the caller seeded them: [`WarmStart`]; else the committed ones,
+    /// which an unseeded `trial`, a copy of `committed`, carries), and are solved to
+    /// round-off: the result is the same function of `(u, committed)` whatever the start.
     fn evaluate_into(
         &self,
         ref_coords: &[Vec3],
@@ -673,6 +752,7 @@ impl Element<DOFS> for SolidShell {
         force: &mut [f64],
         stiffness: Option<&mut [f64]>,
     ) -> Result<()> {
+        type Modes = SVector<f64, ENHANCED_PARAMETERS>;
         super::hex8::check_len("force", force.len(), DOFS)?;
         if let Some(k) = &stiffness {
             super::hex8::check_len("stiffness", k.len(), DOFS * DOFS)?;
@@ -680,37 +760,42 @@ impl Element<DOFS> for SolidShell {
         self.check(committed, trial)?;
         let x = nodes_array("ref_coords", ref_coords)?;
         let u = nodes_array("u", u)?;
-        let points = self.points(&x, &u)?;
+        let (points, levels) = self.points(&x, &u)?;
         let ne = self.modes();
-        let mut alpha: Vec<f64> = committed[0].enhanced[..ne].to_vec();
+        let start = if trial[0].enhanced.iter().all(|a| a.is_finite()) {
+            trial[0].enhanced
+        } else {
+            committed[0].enhanced
+        };
+        let mut alpha = Modes::zeros();
+        alpha.as_mut_slice()[..ne].copy_from_slice(&start[..ne]);
         let strain_scale = points.iter().map(|p| p.strain.amax()).fold(0.0, f64::max);
-        let mut stresses = vec![Voigt::zeros(); points.len()];
-        let mut tangents = vec![Tangent::zeros(); points.len()];
-        let mut k_aa = DMatrix::<f64>::zeros(ne, ne);
+        let np = points.len();
+        let mut stresses = [Voigt::zeros(); 4 * MAX_THICKNESS_POINTS];
+        let mut tangents = [Tangent::zeros(); 4 * MAX_THICKNESS_POINTS];
         let mut previous_step = f64::INFINITY;
         for iteration in 0.. {
-            let mut r_a = DVector::<f64>::zeros(ne);
-            k_aa.fill(0.0);
+            let mut r_a = Modes::zeros();
+            let mut k_aa = SMatrix::<f64, ENHANCED_PARAMETERS, ENHANCED_PARAMETERS>::zeros();
             for (p, point) in points.iter().enumerate() {
                 let (s, c) = self
                     .material_at(point, &alpha, &committed[p], &mut trial[p], material)
                     .map_err(|e| prefix(e, &format!("integration point {p}")))?;
-                for m in 0..ne {
-                    let cm = c * point.modes[m];
-                    r_a[m] += point.dv * point.modes[m].dot(&s);
-                    for l in 0..ne {
-                        k_aa[(l, m)] += point.dv * point.modes[l].dot(&cm);
-                    }
-                }
+                r_a.gemv_tr(point.dv, &point.modes, &s, 1.0);
+                let cm = c * point.modes;
+                k_aa.gemm_tr(point.dv, &point.modes, &cm, 1.0);
                 stresses[p] = s;
                 tangents[p] = c;
             }
-            let step =
-                k_aa.clone().lu().solve(&r_a).ok_or_else(|| {
-                    Error::NoConvergence("singular enhanced-strain stiffness".into())
-                })?;
+            // Inactive parameters: identity rows, zero residual.
+            for m in ne..ENHANCED_PARAMETERS {
+                k_aa[(m, m)] = 1.0;
+            }
+            let step = k_aa.lu().solve(&r_a).ok_or_else(|| {
+                Error::NoConvergence("singular enhanced-strain stiffness".into())
+            })?;
             let size = step.amax();
-            let scale = strain_scale.max(alpha.iter().fold(0.0, |m, a| m.max(a.abs())));
+            let scale = strain_scale.max(alpha.amax());
             // Converged, or stalled at round-off (the step no longer shrinks).
             if size <= 1e-14 * scale
                 || (iteration >= 2 && size <= 1e-9 * scale && size > 0.25 * previous_step)
@@ -724,57 +809,48 @@ impl Element<DOFS> for SolidShell {
                 )));
             }
             previous_step = size;
-            for (a, d) in alpha.iter_mut().zip(step.iter()) {
-                *a -= d;
-            }
+            alpha -= step;
         }
         let force: &mut [f64; DOFS] = force.try_into().expect("length checked");
-        force.fill(0.0);
-        for (point, s) in points.iter().zip(&stresses) {
-            let f = point.b.transpose() * s * point.dv;
-            for i in 0..DOFS {
-                force[i] += f[i];
-            }
+        let mut f = SVector::<f64, DOFS>::zeros();
+        for ((point, s), state) in points.iter().zip(&stresses).zip(trial.iter_mut()) {
+            f.gemv_tr(point.dv, &point.b, s, 1.0);
+            self.finish_point(point, s, &alpha, state);
         }
+        force.copy_from_slice(f.as_slice());
         let Some(k_out) = stiffness else {
             return Ok(());
         };
         let mut k = SMatrix::<f64, DOFS, DOFS>::zeros();
-        let mut k_ua = DMatrix::<f64>::zeros(DOFS, ne);
-        let mut k_au = DMatrix::<f64>::zeros(ne, DOFS);
-        for (point, c) in points.iter().zip(&tangents) {
-            let cb = c * point.b * point.dv;
-            k += point.b.transpose() * cb;
-            for m in 0..ne {
-                let mode = &point.modes[m];
-                let row = mode.transpose() * cb;
-                let col = point.b.transpose() * (c * mode) * point.dv;
-                for i in 0..DOFS {
-                    k_au[(m, i)] += row[i];
-                    k_ua[(i, m)] += col[i];
-                }
-            }
+        let mut k_ua = SMatrix::<f64, DOFS, ENHANCED_PARAMETERS>::zeros();
+        let mut k_au = SMatrix::<f64, ENHANCED_PARAMETERS, DOFS>::zeros();
+        let mut k_aa = SMatrix::<f64, ENHANCED_PARAMETERS, ENHANCED_PARAMETERS>::zeros();
+        for (point, c) in points.iter().zip(&tangents[..np]) {
+            let cb = c * point.b;
+            k.gemm_tr(point.dv, &point.b, &cb, 1.0);
+            k_au.gemm_tr(point.dv, &point.modes, &cb, 1.0);
+            let cm = c * point.modes;
+            k_ua.gemm_tr(point.dv, &point.b, &cm, 1.0);
+            k_aa.gemm_tr(point.dv, &point.modes, &cm, 1.0);
         }
         if self.finite {
-            self.add_geometric(&points, &stresses, &mut k);
+            self.add_geometric(&points, &levels, &stresses[..np], &mut k);
         }
-        let lu = k_aa.lu();
-        let correction = lu
+        for m in ne..ENHANCED_PARAMETERS {
+            k_aa[(m, m)] = 1.0;
+        }
+        let correction = k_aa
+            .lu()
             .solve(&k_au)
             .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))?;
-        let condensed = &k_ua * correction;
-        for j in 0..DOFS {
-            for i in 0..DOFS {
-                k[(i, j)] -= condensed[(i, j)];
-            }
-        }
+        k.gemm(-1.0, &k_ua, &correction, 1.0);
         k_out.copy_from_slice(k.as_slice());
         Ok(())
     }
 
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>> {
         let x = nodes_array("ref_coords", ref_coords)?;
-        let (zeta, wz) = thickness_rule(self.thickness_points);
+        let (zeta, wz) = cached_rule(self.thickness_points);
         let mut out = Vec::with_capacity(self.point_count());
         for (k, z) in zeta.iter().enumerate() {
             for q in 0..4 {

@@ -301,6 +301,8 @@ pub struct IncrementContext<'a> {
     pub is_fixed: &'a [bool],
     /// Contact status imposed per (tool, candidate) by the anti-cycling treatment.
     pub forced: Option<Vec<Vec<Option<crate::contact::ContactStatus>>>>,
+    /// The solid-shell's enhanced parameters of the last evaluation, its next start.
+    pub warm_start: crate::element::solid_shell::WarmStart,
 }
 
 impl IncrementContext<'_> {
@@ -438,6 +440,7 @@ impl IncrementContext<'_> {
             }
         };
         let mut trial_points = self.committed_points.to_vec();
+        self.warm_start.seed(&mut trial_points);
 
         if with_jacobian {
             times.full_evaluations += 1;
@@ -584,6 +587,7 @@ impl IncrementContext<'_> {
         } else {
             jac.values = Vec::new();
         }
+        self.warm_start.keep(&trial_points);
         Ok(Evaluation {
             residual,
             jacobian: jac,
@@ -768,6 +772,7 @@ mod tests {
                 frozen: None,
                 is_fixed: &is_fixed,
                 forced: None,
+                warm_start: Default::default(),
             };
             let mut times = PhaseTimes::default();
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();

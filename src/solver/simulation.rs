@@ -292,6 +292,7 @@ impl Simulation {
             frozen,
             is_fixed: &self.is_fixed,
             forced: None,
+            warm_start: Default::default(),
         }
     }
 
