@@ -178,7 +178,7 @@ impl Mesh {
 
 /// The `n + 1` node coordinates along axis `d` of a block, strictly increasing from
 /// `origin` to exactly `origin + size`.
-fn axis_coordinates(
+pub(super) fn axis_coordinates(
     d: usize,
     origin: f64,
     size: f64,

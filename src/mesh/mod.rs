@@ -39,11 +39,13 @@ mod import;
 pub mod inp;
 mod map;
 mod merge;
+mod ogrid;
 mod sets;
 
 pub use block::{End, Grading, MAX_BLOCK_NODES};
 pub use faces::{quad_area, HEX_FACES};
 pub use grading::core_and_growth;
+pub use ogrid::RoundBlank;
 
 /// Natural coordinates (xi, eta, zeta) of the 8 corners of the reference hexahedron
 /// [-1, 1]^3, in VTK_HEXAHEDRON order (see the module documentation).

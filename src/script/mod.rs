@@ -9,6 +9,7 @@ mod api_charts;
 mod api_mesh_import;
 mod api_mesh_map;
 mod api_numbers;
+mod api_round_blank;
 mod api_scene;
 mod api_sim;
 mod api_tools;
@@ -111,6 +112,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     api_scene::register(&mut engine, host.clone());
     api_cad::register(&mut engine, policy.clone());
     api_mesh_import::register(&mut engine, policy.clone(), host.limits.clone());
+    api_round_blank::register(&mut engine, host.limits.clone());
     api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);
