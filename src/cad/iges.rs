@@ -10,11 +10,14 @@
 //!   102 composite curve of those,
 //! - 124 transformation matrix on a surface or face (applied exactly to control points).
 //!
-//! Faces are the 144 entities and the 128 entities no 144 or 142 refers to, in directory
-//! order. Analytic surfaces (108 plane, 120 revolution, 122 tabulated cylinder, 190-198
-//! solid-model surfaces) are refused naming the entity: export B-splines instead
-//! (OpenCascade: `BRepBuilderAPI_NurbsConvert`). Other entities (annotations, groups,
-//! model-space curves) are ignored. Every error names the file and the line (`file:line`),
+//! - analytic surfaces a CAD exporter writes (in [`super::iges_analytic`]): 108 plane
+//!   (trimmed by its model-space curves) and 120 surface of revolution, made exact NURBS.
+//!
+//! Faces are the 144 entities, and the 128, 120 and bounded 108 entities no 144 or 142
+//! refers to, in directory order. Other surfaces (114, 118, 122, 140, 143, 190-198) are
+//! refused naming the entity: export B-splines instead (OpenCascade:
+//! `BRepBuilderAPI_NurbsConvert`). Other entities (annotations, groups, model-space
+//! curves) are ignored. Every error names the file and the line (`file:line`),
 //! and for an entity its type and directory line; the file's text is never echoed.
 
 use super::Face;
@@ -26,16 +29,16 @@ use std::collections::HashSet;
 
 /// One directory entry (two D lines).
 #[derive(Debug, Clone)]
-struct Entry {
-    kind: i64,
+pub(super) struct Entry {
+    pub(super) kind: i64,
     /// First P line of the parameter data (1-based sequence number).
     data: usize,
     /// Directory line of a 124 transformation, or 0.
     matrix: usize,
     data_lines: usize,
-    form: i64,
+    pub(super) form: i64,
     /// Physical line of the first D line, for messages.
-    file_line: usize,
+    pub(super) file_line: usize,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -46,15 +49,15 @@ enum Token {
 }
 
 /// The parsed sections of a file.
-struct Iges<'a> {
-    source: &'a str,
+pub(super) struct Iges<'a> {
+    pub(super) source: &'a str,
     entries: Vec<Entry>,
     /// P lines: (physical line, data columns 1-64).
     data: Vec<(usize, &'a str)>,
     delimiter: char,
     record: char,
     /// Multiplies model coordinates to give millimetres.
-    to_mm: f64,
+    pub(super) to_mm: f64,
 }
 
 fn name(kind: i64) -> &'static str {
@@ -90,9 +93,7 @@ fn name(kind: i64) -> &'static str {
 }
 
 /// Surfaces a CAD exporter may write that are not read (a face on one is refused).
-const UNREAD_SURFACES: [i64; 13] = [
-    108, 114, 118, 120, 122, 140, 143, 186, 190, 192, 194, 196, 198,
-];
+const UNREAD_SURFACES: [i64; 11] = [114, 118, 122, 140, 143, 186, 190, 192, 194, 196, 198];
 
 /// Millimetres per unit of the global section's unit flag (IGES 5.3, parameter 14).
 fn unit_to_mm(flag: i64, unit_name: &str) -> Option<f64> {
@@ -191,7 +192,7 @@ fn tokenize(text: &str, delimiter: char, record: char) -> Tokens {
 }
 
 /// Parameters of one entity, with the context for messages.
-struct Params<'a> {
+pub(super) struct Params<'a> {
     tokens: Vec<Token>,
     at: String,
     source: &'a str,
@@ -199,7 +200,7 @@ struct Params<'a> {
 }
 
 impl Params<'_> {
-    fn fail(&self, message: String) -> Error {
+    pub(super) fn fail(&self, message: String) -> Error {
         Error::Input(format!(
             "{}:{}: {}: {message}",
             self.source, self.line, self.at
@@ -207,7 +208,7 @@ impl Params<'_> {
     }
 
     /// Parameter `i` (1 = the first after the entity type) as a number; empty means 0.
-    fn real(&self, i: usize, what: &str) -> Result<f64> {
+    pub(super) fn real(&self, i: usize, what: &str) -> Result<f64> {
         match self.tokens.get(i) {
             Some(Token::Number(x)) if x.is_finite() => Ok(*x),
             Some(Token::Empty) => Ok(0.0),
@@ -218,7 +219,7 @@ impl Params<'_> {
         }
     }
 
-    fn int(&self, i: usize, what: &str) -> Result<i64> {
+    pub(super) fn int(&self, i: usize, what: &str) -> Result<i64> {
         let x = self.real(i, what)?;
         if x.fract() != 0.0 || x.abs() > 1e12 {
             return Err(self.fail(format!("parameter {i} ({what}) = {x} is not an integer")));
@@ -226,7 +227,7 @@ impl Params<'_> {
         Ok(x as i64)
     }
 
-    fn count(&self, i: usize, what: &str) -> Result<usize> {
+    pub(super) fn count(&self, i: usize, what: &str) -> Result<usize> {
         let x = self.int(i, what)?;
         if !(0..=1_000_000).contains(&x) {
             return Err(self.fail(format!("parameter {i} ({what}) = {x} is out of range")));
@@ -234,7 +235,7 @@ impl Params<'_> {
         Ok(x as usize)
     }
 
-    fn reals(&self, from: usize, n: usize, what: &str) -> Result<Vec<f64>> {
+    pub(super) fn reals(&self, from: usize, n: usize, what: &str) -> Result<Vec<f64>> {
         (from..from + n).map(|i| self.real(i, what)).collect()
     }
 }
@@ -420,7 +421,7 @@ impl<'a> Iges<'a> {
     }
 
     /// The entry a directory pointer (odd D line number) names.
-    fn entry(&self, pointer: i64, from: &Params, what: &str) -> Result<&Entry> {
+    pub(super) fn entry(&self, pointer: i64, from: &Params, what: &str) -> Result<&Entry> {
         let index = usize::try_from(pointer - 1)
             .ok()
             .filter(|i| i % 2 == 0)
@@ -433,7 +434,7 @@ impl<'a> Iges<'a> {
         })
     }
 
-    fn describe(e: &Entry) -> String {
+    pub(super) fn describe(e: &Entry) -> String {
         format!(
             "entity {} ({}) at D line {}",
             e.kind,
@@ -442,7 +443,7 @@ impl<'a> Iges<'a> {
         )
     }
 
-    fn params(&self, e: &Entry) -> Result<Params<'a>> {
+    pub(super) fn params(&self, e: &Entry) -> Result<Params<'a>> {
         let at = Self::describe(e);
         let fail = |m: String| Error::Input(format!("{}:{}: {at}: {m}", self.source, e.file_line));
         if e.data == 0 || e.data_lines == 0 || e.data - 1 + e.data_lines > self.data.len() {
@@ -501,8 +502,20 @@ impl<'a> Iges<'a> {
                         trim: None,
                         origin: Self::describe(e),
                         flip: false,
+                        arcs: [None, None],
                     });
                 }
+                120 if !used.contains(&pointer) => {
+                    let (surface, arcs) = self.revolution(e)?;
+                    faces.push(Face {
+                        surface,
+                        trim: None,
+                        origin: Self::describe(e),
+                        flip: false,
+                        arcs,
+                    });
+                }
+                108 if !used.contains(&pointer) => faces.push(self.bounded_plane(e)?),
                 k if UNREAD_SURFACES.contains(&k) && !used.contains(&pointer) => {
                     return Err(self.unread_surface(e))
                 }
@@ -511,7 +524,7 @@ impl<'a> Iges<'a> {
         }
         if faces.is_empty() {
             return Err(Error::Input(format!(
-                "{}: no face (entity 128 or 144) in the file",
+                "{}: no face (entity 128, 144, 120 or bounded 108) in the file",
                 self.source
             )));
         }
@@ -530,7 +543,7 @@ impl<'a> Iges<'a> {
     }
 
     /// `x -> R x + t` of a 124 entity (and of the 124s it chains to), identity for 0.
-    fn matrix(&self, e: &Entry, depth: usize) -> Result<(Mat3, Vec3)> {
+    pub(super) fn matrix(&self, e: &Entry, depth: usize) -> Result<(Mat3, Vec3)> {
         if e.matrix == 0 {
             return Ok((Mat3::identity(), Vec3::zeros()));
         }
@@ -594,16 +607,18 @@ impl<'a> Iges<'a> {
     fn trimmed_face(&self, e: &Entry) -> Result<Face> {
         let p = self.params(e)?;
         let s = self.entry(p.int(1, "PTS, surface pointer")?, &p, "surface")?;
-        if s.kind != 128 {
-            if UNREAD_SURFACES.contains(&s.kind) {
-                return Err(self.unread_surface(s));
+        let (surface, arcs) = match s.kind {
+            128 => (self.surface(s)?, [None, None]),
+            120 => self.revolution(s)?,
+            108 => return self.trimmed_plane(e, &p, s),
+            k if UNREAD_SURFACES.contains(&k) => return Err(self.unread_surface(s)),
+            _ => {
+                return Err(p.fail(format!(
+                    "its surface pointer names {}, not a surface",
+                    Self::describe(s)
+                )))
             }
-            return Err(p.fail(format!(
-                "its surface pointer names {}, not a surface",
-                Self::describe(s)
-            )));
-        }
-        let surface = self.surface(s)?;
+        };
         let outer = p.int(2, "N1, outer boundary flag")?;
         let holes = p.count(3, "N2, inner boundary count")?;
         let [u, v] = surface.domain();
@@ -628,11 +643,12 @@ impl<'a> Iges<'a> {
             trim: Some(trim),
             origin: Self::describe(e),
             flip: false,
+            arcs,
         })
     }
 
     /// A 142 curve on surface: the segments of its parameter-space curve.
-    fn boundary(&self, pointer: i64, face: &Params) -> Result<Vec<TrimSegment>> {
+    pub(super) fn boundary(&self, pointer: i64, face: &Params) -> Result<Vec<TrimSegment>> {
         let c = self.entry(pointer, face, "boundary")?;
         if c.kind != 142 {
             return Err(face.fail(format!(
@@ -675,26 +691,15 @@ impl<'a> Iges<'a> {
             }
             100 => out.extend(arc(&p.reals(1, 7, "arc parameter")?)),
             126 => {
-                let k = p.count(1, "K, upper index")?;
-                let m = p.count(2, "M, degree")?;
-                let n = k + 1;
-                let knots = p.reals(7, k + m + 2, "knot")?;
-                let w = p.reals(7 + k + m + 2, n, "weight")?;
-                let xyz = p.reals(7 + k + m + 2 + n, 3 * n, "control point coordinate")?;
-                let range = p.reals(7 + k + m + 2 + 4 * n, 2, "parameter range V0 V1")?;
-                check_knots("curve", m, n, &knots).map_err(|e| p.fail(super::strip(e)))?;
-                if let Some(bad) = w.iter().position(|w| !(w.is_finite() && *w > 0.0)) {
-                    return Err(p.fail(format!("weight {bad} = {} must be > 0", w[bad])));
-                }
-                let (a, b) = (knots[m], knots[n]);
-                if !(a <= range[0] && range[0] < range[1] && range[1] <= b) {
-                    return Err(p.fail(format!(
-                        "parameter range [{}, {}] must be inside the knot domain [{a}, {b}]",
-                        range[0], range[1]
-                    )));
-                }
+                let BsplineCurve {
+                    degree: m,
+                    knots,
+                    weights: w,
+                    xyz,
+                    range,
+                } = bspline_curve(&p)?;
                 let uv: Vec<f64> = xyz.chunks(3).flat_map(|c| [c[0], c[1]]).collect();
-                for (h, _) in curve_segments(m, &knots, &uv, &w, 2, [range[0], range[1]]) {
+                for (h, _) in curve_segments(m, &knots, &uv, &w, 2, range) {
                     out.push(TrimSegment::new(
                         h.chunks(3).map(|c| [c[0], c[1], c[2]]).collect(),
                     ));
@@ -710,6 +715,46 @@ impl<'a> Iges<'a> {
         }
         Ok(())
     }
+}
+
+/// The data of a 126 rational B-spline curve, checked.
+pub(super) struct BsplineCurve {
+    pub(super) degree: usize,
+    pub(super) knots: Vec<f64>,
+    pub(super) weights: Vec<f64>,
+    /// Control points, three coordinates each.
+    pub(super) xyz: Vec<f64>,
+    pub(super) range: [f64; 2],
+}
+
+/// Reads a 126 entity's parameters: knots (see [`check_knots`]), weights > 0, and the
+/// parameter range inside the knot domain.
+pub(super) fn bspline_curve(p: &Params) -> Result<BsplineCurve> {
+    let k = p.count(1, "K, upper index")?;
+    let m = p.count(2, "M, degree")?;
+    let n = k + 1;
+    let knots = p.reals(7, k + m + 2, "knot")?;
+    let w = p.reals(7 + k + m + 2, n, "weight")?;
+    let xyz = p.reals(7 + k + m + 2 + n, 3 * n, "control point coordinate")?;
+    let range = p.reals(7 + k + m + 2 + 4 * n, 2, "parameter range V0 V1")?;
+    check_knots("curve", m, n, &knots).map_err(|e| p.fail(super::strip(e)))?;
+    if let Some(bad) = w.iter().position(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(p.fail(format!("weight {bad} = {} must be > 0", w[bad])));
+    }
+    let (a, b) = (knots[m], knots[n]);
+    if !(a <= range[0] && range[0] < range[1] && range[1] <= b) {
+        return Err(p.fail(format!(
+            "parameter range [{}, {}] must be inside the knot domain [{a}, {b}]",
+            range[0], range[1]
+        )));
+    }
+    Ok(BsplineCurve {
+        degree: m,
+        knots,
+        weights: w,
+        xyz,
+        range: [range[0], range[1]],
+    })
 }
 
 /// A 100 circular arc (`ZT, centre, start, end`, counter-clockwise) as rational quadratic

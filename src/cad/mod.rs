@@ -7,6 +7,7 @@
 //! builds the [`PatchSurface`], which runs the seam, fold and orientation checks.
 
 pub mod iges;
+mod iges_analytic;
 pub mod nurbs_json;
 pub mod step;
 
@@ -27,6 +28,11 @@ pub struct Face {
     /// The face's outward side is that of `-S_u x S_v` (a STEP face with `same_sense`
     /// false).
     pub flip: bool,
+    /// Along `u`, `v`: the half angle of every knot span if the surface runs that way by
+    /// circular arcs in normal form while the trim is given in (an affine function of) the
+    /// angle, as on an IGES surface of revolution; `None`: the trim uses the surface's own
+    /// parameter.
+    pub arcs: [Option<f64>; 2],
 }
 
 /// What to make of the faces of a file.
@@ -87,6 +93,7 @@ pub fn tool_surface(
                 region: r.clone(),
                 u: piece.u,
                 v: piece.v,
+                arcs: face.arcs,
             }));
         }
     }

@@ -163,6 +163,7 @@ fn face(v: &Value, name: &str) -> Result<Face> {
         trim,
         origin: name.to_string(),
         flip: false,
+        arcs: [None, None],
     })
 }
 

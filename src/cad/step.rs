@@ -742,6 +742,7 @@ impl<'a> Step<'a> {
                 trim,
                 origin: format!("#{id} (ADVANCED_FACE) at line {}", inst.line),
                 flip: !same_sense,
+                arcs: [None, None],
             });
         }
         if faces.is_empty() {

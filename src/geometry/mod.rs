@@ -7,6 +7,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+pub mod analytic_nurbs;
 pub mod bezier;
 pub mod builders;
 pub mod bvh;

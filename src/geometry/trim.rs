@@ -220,19 +220,33 @@ impl TrimRegion {
 }
 
 /// Where a Bézier piece of a trimmed face sits in the face's parameter plane: its
-/// `(s, t)` in `[0, 1]^2` is `(u0 + s (u1 - u0), v0 + t (v1 - v0))` of `region`.
+/// `(s, t)` in `[0, 1]^2` is `(u0 + f(s) (u1 - u0), v0 + f(t) (v1 - v0))` of `region`,
+/// with `f` the identity, or along a direction whose pieces are circular arcs in normal
+/// form of half angle `h` (the face's parameter being affine in the angle), the half-angle
+/// tangent law `f(s) = 1/2 + atan((2 s - 1) tan(h / 2)) / h`
+/// (see [`crate::geometry::analytic_nurbs`]).
 #[derive(Debug, Clone)]
 pub struct PieceTrim {
     pub region: std::sync::Arc<TrimRegion>,
     pub u: [f64; 2],
     pub v: [f64; 2],
+    /// Arc half angle along `u` and along `v`, or `None` where `f` is the identity.
+    pub arcs: [Option<f64>; 2],
+}
+
+/// The fraction of a piece's parameter interval at its own parameter `s` (see [`PieceTrim`]).
+fn fraction(s: f64, arc: Option<f64>) -> f64 {
+    match arc {
+        None => s,
+        Some(h) => 0.5 + ((2.0 * s - 1.0) * (0.5 * h).tan()).atan() / h,
+    }
 }
 
 impl PieceTrim {
     /// True if the piece's point `(s, t)` is on the trimmed face.
     pub fn admits(&self, s: f64, t: f64) -> bool {
-        let u = self.u[0] + s * (self.u[1] - self.u[0]);
-        let v = self.v[0] + t * (self.v[1] - self.v[0]);
+        let u = self.u[0] + fraction(s, self.arcs[0]) * (self.u[1] - self.u[0]);
+        let v = self.v[0] + fraction(t, self.arcs[1]) * (self.v[1] - self.v[0]);
         self.region.contains(u, v)
     }
 }

@@ -11,11 +11,14 @@ Dimensions (mm) as in std-lib/numisheet93.rhai and src/geometry/builders.rs:
 Both are made as OCC makes them from a sketch: a box, the vertical edges filleted (plan
 corners), then the edges of the working face filleted (nose / entry radius).
 
-OCC writes planes, cylinders and tori as analytic entities. tribo reads rational B-spline
-surfaces, so each solid is converted with BRepBuilderAPI_NurbsConvert (exact: circles and
-tori become rational quadratic B-splines) before the `*_nurbs.igs` / `*_nurbs.step`
-export. The unconverted `punch_analytic.igs` / `.step` are kept to check that unsupported entities
-are refused with their type and index.
+OCC writes planes, cylinders and tori as analytic entities: in IGES, 108 planes trimmed by
+model-space curves and 120 surfaces of revolution (line or arc generatrix) trimmed in
+their (t, angle) parameters. tribo reads those (`punch_analytic.igs`, `die_analytic.igs`)
+and, from both formats, rational B-spline surfaces, for which each solid is converted with
+BRepBuilderAPI_NurbsConvert (exact: circles and tori become rational quadratic B-splines)
+before the `*_nurbs.igs` / `*_nurbs.step` export. `punch_analytic.step` (STEP's PLANE,
+CYLINDRICAL_SURFACE, TOROIDAL_SURFACE, not read) checks that unread surfaces are refused
+with their type and index.
 """
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
 from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
@@ -104,6 +107,7 @@ if __name__ == "__main__":
     p, d = punch(), die()
     write_iges(p, "punch_analytic.igs")
     write_step(p, "punch_analytic.step")
+    write_iges(d, "die_analytic.igs")
     for name, shape in (("punch", p), ("die", d)):
         n = nurbs(shape)
         write_iges(n, f"{name}_nurbs.igs")
