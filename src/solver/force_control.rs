@@ -153,6 +153,23 @@ pub fn approaching(
         && !nodal[c].iter().any(|(r, _)| r.status.is_active())
 }
 
+/// Approach: the smallest travel of force-controlled tool `c` along its axis that closes
+/// a gap (the offset change that brings it into touch with the nearest node ahead of it),
+/// `None` if no node lies ahead or the tool is not force-controlled. O(candidates).
+pub fn approach_travel(
+    model: &Model,
+    c: usize,
+    nodal: &[Vec<(NodalContact, Option<Projection>)>],
+) -> Option<f64> {
+    let fc = model.contacts[c].tool.force_control.as_ref()?;
+    nodal[c]
+        .iter()
+        .filter_map(|(_, p)| p.as_ref())
+        .filter(|p| p.normal.dot(&fc.axis) > 1e-3)
+        .map(|p| p.gap / p.normal.dot(&fc.axis))
+        .min_by(f64::total_cmp)
+}
+
 /// Mean augmentation parameter of tool `c`: the scale of its force row.
 pub fn row_scale(model: &Model, c: usize) -> f64 {
     let r = &model.contacts[c].r;
@@ -191,19 +208,12 @@ pub fn add_force_rows(
             }
             residual[s] = (pushed - fc.force.value(time)) / r_s;
         } else {
-            // Approach: the smallest travel along the axis that closes a gap.
-            let travel = nodal[c]
-                .iter()
-                .filter_map(|(_, p)| p.as_ref())
-                .filter(|p| p.normal.dot(&fc.axis) > 1e-3)
-                .map(|p| p.gap / p.normal.dot(&fc.axis))
-                .min_by(f64::total_cmp)
-                .ok_or_else(|| {
-                    Error::NoConvergence(format!(
-                        "force-controlled tool '{}' touches no node and no node lies ahead of it along its axis [{}, {}, {}]: its position is undetermined",
-                        contact.tool.name, fc.axis.x, fc.axis.y, fc.axis.z
-                    ))
-                })?;
+            let travel = approach_travel(model, c, nodal).ok_or_else(|| {
+                Error::NoConvergence(format!(
+                    "force-controlled tool '{}' touches no node and no node lies ahead of it along its axis [{}, {}, {}]: its position is undetermined",
+                    contact.tool.name, fc.axis.x, fc.axis.y, fc.axis.z
+                ))
+            })?;
             residual[s] = -travel;
             jac.add(s, s, 1.0);
         }

@@ -261,6 +261,9 @@ impl Simulation {
                 eval = ctx.evaluate(&x, &mut times)?;
             }
         }
+        if self.seat_force_controlled_tools(&eval, &mut x) {
+            eval = ctx.evaluate(&x, &mut times)?;
+        }
         let mut residuals = Vec::new();
         let mut merits: Vec<f64> = Vec::new();
         let mut iterations = 0;

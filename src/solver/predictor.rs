@@ -2,7 +2,8 @@
 //! increment's motion continued) and the linearised Dirichlet predictor (prescribed jumps
 //! spread over the body by one tangent solve).
 
-use super::assembly::{IncrementContext, PhaseTimes};
+use super::assembly::{Evaluation, IncrementContext, PhaseTimes};
+use super::force_control;
 use super::linear::LinearSolver;
 use super::simulation::Simulation;
 use crate::Result;
@@ -60,5 +61,36 @@ impl Simulation {
             *xi += d;
         }
         Ok(())
+    }
+
+    /// Seats every force-controlled tool that touches no node at `eval` (the evaluation of
+    /// `x`): its offset moves along its axis by the approach travel, into touch with the
+    /// nearest node ahead of it (overlapping it by a thousandth of the contact tolerance, so
+    /// that a node touching with a zero multiplier counts as touching, not as a round-off
+    /// gap). Returns whether an offset moved (then `x` must be evaluated again).
+    ///
+    /// Why: a tool touching nothing has the approach equation as its row, and the Newton
+    /// step that solves it also moves the body under a Jacobian without that tool. Where
+    /// the tool is what holds the body (a holder pressing a strip's flange), that Jacobian
+    /// is nearly singular: on the U-channel an extrapolated start opened the holder's four
+    /// nodes by 1e-4 mm, and the step moved nodes by 20 mm and turned elements inside out.
+    /// Moving the offset alone changes only the start of Newton, not the discrete problem
+    /// (the offset is an unknown like the others). O(candidates).
+    pub(super) fn seat_force_controlled_tools(&self, eval: &Evaluation, x: &mut [f64]) -> bool {
+        let overlap = 1e-3 * self.model.settings.contact_tol;
+        let mut moved = false;
+        for c in 0..self.model.contacts.len() {
+            let Some(s) = self.dofs.tool_offset[c] else {
+                continue;
+            };
+            if !force_control::approaching(&self.model, c, &eval.nodal) {
+                continue;
+            }
+            if let Some(travel) = force_control::approach_travel(&self.model, c, &eval.nodal) {
+                x[s] += travel + overlap;
+                moved = true;
+            }
+        }
+        moved
     }
 }
