@@ -547,7 +547,16 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     let res: Array = r
         .residuals
         .iter()
-        .map(|x| Dynamic::from(vec![Dynamic::from(x.force_rel), Dynamic::from(x.contact)]))
+        .map(|x| {
+            Dynamic::from(vec![
+                Dynamic::from(x.force_rel),
+                Dynamic::from(x.contact),
+                Dynamic::from(x.status_changes as i64),
+                Dynamic::from(x.yield_changes as i64),
+                Dynamic::from(x.full_step),
+                Dynamic::from(x.correction),
+            ])
+        })
         .collect();
     m.insert("residuals".into(), Dynamic::from(res));
     let mut forces = Map::new();

@@ -7,7 +7,7 @@ use super::cycling::{CyclingMonitor, CyclingNode};
 use super::force_control;
 use super::linear::LinearSolver;
 use super::simulation::Simulation;
-use crate::contact::FrameUpdate;
+use crate::contact::{ContactStatus, FrameUpdate};
 use crate::{Error, Result};
 use std::time::Instant;
 
@@ -29,6 +29,27 @@ pub struct IterationRecord {
     pub force: f64,
     /// Contact residual (max |F_suppl|, length units).
     pub contact: f64,
+    /// Contact pairs whose status differs from the previous iterate's (0 at the first
+    /// iterate of an increment): Newton's local (quadratic) phase is the iterates after the
+    /// last change.
+    #[serde(default)]
+    pub status_changes: usize,
+    /// Material points that started or stopped yielding in this increment since the previous
+    /// iterate (the material's own active set; 0 at the first iterate).
+    #[serde(default)]
+    pub yield_changes: usize,
+    /// Whether this iterate was reached by a whole Newton step (no line-search cut; true at
+    /// the first iterate).
+    #[serde(default = "full_step_default")]
+    pub full_step: bool,
+    /// 2-norm of the displacement part of the Newton correction solved at this iterate (0
+    /// at the converged iterate, where none is solved).
+    #[serde(default)]
+    pub correction: f64,
+}
+
+fn full_step_default() -> bool {
+    true
 }
 
 /// A converged Newton solve of one increment, not yet committed.
@@ -134,6 +155,10 @@ impl Simulation {
                 force_rel: force / reference,
                 force,
                 contact,
+                status_changes: 0,
+                yield_changes: 0,
+                full_step: true,
+                correction: 0.0,
             },
             merit,
             reference,
@@ -265,6 +290,9 @@ impl Simulation {
             eval = ctx.evaluate(&x, &mut times)?;
         }
         let mut residuals = Vec::new();
+        let mut statuses: Vec<Vec<ContactStatus>> = Vec::new();
+        let mut yielding: Vec<bool> = Vec::new();
+        let mut arrived_whole = true;
         let mut merits: Vec<f64> = Vec::new();
         let mut iterations = 0;
         let mut line_search_cuts = 0;
@@ -281,7 +309,10 @@ impl Simulation {
                 window_start = merits.len();
                 next_step = None;
             }
-            let (rec, merit, reference) = self.residual_record(&eval, &weights);
+            let (mut rec, merit, reference) = self.residual_record(&eval, &weights);
+            rec.status_changes = status_changes(&mut statuses, &eval);
+            rec.yield_changes = yield_changes(&mut yielding, &self.points, &eval);
+            rec.full_step = arrived_whole;
             residuals.push(rec);
             merits.push(merit);
             let cycling_note = || {
@@ -358,6 +389,9 @@ impl Simulation {
                 None => self.newton_step(&eval, linear)?,
             };
             times.factorization_and_solve += ts.elapsed().as_secs_f64();
+            if let Some(last) = residuals.last_mut() {
+                last.correction = norm(&dx[..n_u]);
+            }
             // A step that brings a force-controlled tool to first touch is taken whole: the
             // merit cannot judge it (its force row only starts to count once touching).
             let approach = (0..self.model.contacts.len())
@@ -387,6 +421,7 @@ impl Simulation {
             }
             next_step = contracted;
             line_search_cuts += cuts;
+            arrived_whole = cuts == 0 && monitor.damping() == 1.0;
             x = x_new;
             eval = eval_new;
             iterations += 1;
@@ -428,6 +463,43 @@ impl Simulation {
             })
             .collect()
     }
+}
+
+/// How many contact pairs of `eval` have another status than in `previous` (none when
+/// `previous` is empty, at the first iterate); `previous` becomes `eval`'s statuses.
+fn status_changes(previous: &mut Vec<Vec<ContactStatus>>, eval: &Evaluation) -> usize {
+    let now: Vec<Vec<ContactStatus>> = eval
+        .nodal
+        .iter()
+        .map(|list| list.iter().map(|(n, _)| n.status).collect())
+        .collect();
+    let changes = previous
+        .iter()
+        .flatten()
+        .zip(now.iter().flatten())
+        .filter(|(a, b)| a != b)
+        .count();
+    *previous = now;
+    changes
+}
+
+/// How many material points of `eval` yield (plastic strain grown over the committed
+/// state) where they did not at the previous iterate, or the reverse; `previous` (empty at
+/// the first iterate) becomes `eval`'s flags.
+fn yield_changes(
+    previous: &mut Vec<bool>,
+    committed: &[crate::material::PointState],
+    eval: &Evaluation,
+) -> usize {
+    let now: Vec<bool> = eval
+        .trial_points
+        .iter()
+        .zip(committed)
+        .map(|(t, c)| t.eq_plastic_strain > c.eq_plastic_strain)
+        .collect();
+    let changes = previous.iter().zip(&now).filter(|(a, b)| a != b).count();
+    *previous = now;
+    changes
 }
 
 fn norm(v: &[f64]) -> f64 {
