@@ -1,35 +1,40 @@
 //! The cylindrical cup script (`scripts/cylindrical_cup.rhai`, issue 17) run to 20 mm of
-//! punch travel on its coarse default mesh (quarter O-grid blank, 4 core cells, 168
-//! hexahedra, one layer; the square cup's Newton budget: 100 iterations, 8 cutbacks), through
-//! the real command line.
+//! punch travel on its coarse default mesh (quarter O-grid blank, 4 core cells, 216
+//! hexahedra, one layer; finite strain; the square cup's Newton budget: 100 iterations, 8
+//! cutbacks), through the real command line. About 8 s of CPU per run.
 //!
 //! **Axisymmetry (isotropic material).** Issue 17 asks that the radial draw-in at 0 and 45
 //! deg be equal to 1e-6. The tools are exact surfaces of revolution and the ring of the
-//! O-grid is a polar grid on rays at equal angles, invariant under a 45 deg turn, but its
-//! square core is not: the discrete problem is not rotationally symmetric, so the two
-//! draw-ins differ by a discretisation error, not by round-off. Measured (isotropic, 20 mm,
-//! `tribo run scripts/cylindrical_cup.rhai --set core_cells=N --set ring_cells=4N
-//! --set transition_cells=...`, see docs/geometry.md):
+//! O-grid is a polar grid on rays at equal angles, which a 45 deg turn maps onto itself; its
+//! square core is not, so the discrete problem is not rotationally symmetric and the two
+//! draw-ins differ by a discretisation error that grows with the core. Measured (isotropic,
+//! 20 mm, 4 core cells, `tribo run scripts/cylindrical_cup.rhai --set core_size=A --set
+//! round_radius=RT --set ring_cells=M`):
 //!
-//! | core_cells | hexahedra | draw-in at 0 deg | d(0) - d(45) |
-//! | --- | --- | --- | --- |
-//! | 4 (this test) | 168 | 7.5017 mm | -2.7e-4 mm |
+//! | core half side A | round_radius RT | ring_cells M | d(0) | d(0) - d(45) |
+//! | --- | --- | --- | --- | --- |
+//! | 12 | 24 (transition under the nose) | 16 | 7.707 mm | -6.2e-3 mm |
+//! | 12 | 18 | 16 | 7.498 mm | -9.5e-4 mm |
+//! | 8 | 18 | 16 | 7.502 mm | -2.7e-4 mm |
+//! | 4 | 10 | 20 | 7.501 mm | -6.1e-6 mm |
+//! | 2 (default) | 5 | 22 | 7.605 mm | -4.9e-8 mm |
 //!
-//! so this test holds |d(0) - d(45)| to 1e-3 mm (1.3e-4 of the draw-in), about 4 times the
-//! measured value, and checks what is exact: the mesh, the tools and the material are
-//! mirror-symmetric about the diagonal, so d(0) = d(90) to Newton's tolerance (1e-9).
+//! With the core small and deep under the flat punch bottom (radius 20), the default mesh
+//! meets the issue's 1e-6 mm with a margin of 20, so this test asks exactly that. It also
+//! checks what is exact: the mesh, the tools and the material are mirror-symmetric about
+//! the diagonal, so d(0) = d(90) to Newton's tolerance (1e-9).
 //!
 //! **Ears (Hill48, r0 = r90 = 2, r45 = 1).** Delta r = (r0 + r90 - 2 r45)/2 = 1 > 0: the
-//! flange draws in less at 0 and 90 deg than at 45 deg (ears at 0/90). The test asks the
-//! ear amplitude (d(0) + d(90))/2 - d(45) to be negative and more than 20 times the
-//! isotropic bound above.
+//! flange draws in less at 0 and 90 deg than at 45 deg (ears at 0/90); measured -4.30 mm.
+//! The test asks the ear amplitude (d(0) + d(90))/2 - d(45) to be below -1 mm: 10^6 times
+//! the isotropic bound, and a quarter of the measured value.
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// |d(0) - d(45)| allowed for the isotropic material on the default mesh [mm].
-const ISOTROPIC_BOUND_MM: f64 = 1e-3;
+const ISOTROPIC_BOUND_MM: f64 = 1e-6;
 
 fn run(name: &str, sets: &[&str]) -> Value {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -98,7 +103,7 @@ fn hill48_cup_has_ears_at_0_and_90_degrees() {
     let draw = common_checks(&summary);
     let ears = number(draw, "ears");
     assert!(
-        ears < -20.0 * ISOTROPIC_BOUND_MM,
+        ears < -1e6 * ISOTROPIC_BOUND_MM,
         "ear amplitude {ears} mm (isotropic bound {ISOTROPIC_BOUND_MM}): {draw}"
     );
 }
