@@ -38,8 +38,10 @@ const ISOTROPIC_BOUND_MM: f64 = 1e-6;
 
 fn run(name: &str, sets: &[&str]) -> Value {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out: PathBuf =
-        std::env::temp_dir().join(format!("tribo_cylindrical_cup_{name}_{}", std::process::id()));
+    let out: PathBuf = std::env::temp_dir().join(format!(
+        "tribo_cylindrical_cup_{name}_{}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&out);
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_tribo"));
     cmd.current_dir(root)
@@ -75,7 +77,10 @@ fn common_checks(summary: &Value) -> &Value {
     let draw = &summary["final_draw_in"];
     let (d0, d90) = (number(draw, "d0"), number(draw, "d90"));
     assert!(d0 > 3.0, "the flange was not drawn in: {draw}");
-    assert!((d0 - d90).abs() < 1e-9 * d0.max(1.0), "diagonal mirror: {draw}");
+    assert!(
+        (d0 - d90).abs() < 1e-9 * d0.max(1.0),
+        "diagonal mirror: {draw}"
+    );
     // The rim profile runs from 0 to 90 deg, one entry per rim node on the bottom face.
     let profile = summary["rim_draw_in"].as_array().expect("rim_draw_in");
     assert_eq!(profile.len(), 9);
@@ -89,12 +94,18 @@ fn isotropic_cup_is_axisymmetric_to_the_core_discretisation() {
     let summary = run("isotropic", &[]);
     let draw = common_checks(&summary);
     let gap = number(draw, "d0") - number(draw, "d45");
-    assert!(gap.abs() < ISOTROPIC_BOUND_MM, "d(0) - d(45) = {gap} mm: {draw}");
+    assert!(
+        gap.abs() < ISOTROPIC_BOUND_MM,
+        "d(0) - d(45) = {gap} mm: {draw}"
+    );
     // The force peak of a full cup of this steel: wall stress = F / (2 pi r_wall t) must
     // stay below the Swift flow stress at the strains reached (about 600 MPa).
     let peak = number(&summary, "punch_force_peak_n");
     let wall_stress = peak / (2.0 * std::f64::consts::PI * 25.5 * 1.0);
-    assert!(wall_stress > 100.0 && wall_stress < 600.0, "{wall_stress} MPa");
+    assert!(
+        wall_stress > 100.0 && wall_stress < 600.0,
+        "{wall_stress} MPa"
+    );
 }
 
 #[test]
@@ -106,4 +117,29 @@ fn hill48_cup_has_ears_at_0_and_90_degrees() {
         ears < -1e6 * ISOTROPIC_BOUND_MM,
         "ear amplitude {ears} mm (isotropic bound {ISOTROPIC_BOUND_MM}): {draw}"
     );
+}
+
+/// The whole blank (its in-plane rigid motion held by the axis column and one rim node)
+/// and the quarter model (symmetry planes `"x-"`, `"y-"`) are the same discrete problem
+/// restricted by symmetry: the full cup's punch force and draw-in equal the quarter's to
+/// Newton's tolerance. Measured at 3 mm: equal to 1e-15.
+#[test]
+fn whole_blank_equals_the_quarter_model() {
+    let quarter = run("quarter_2mm", &["travel=2"]);
+    let whole = run("whole_2mm", &["travel=2", "quarter=false"]);
+    for s in [&quarter, &whole] {
+        assert_eq!(s["status"], "finished", "{s}");
+    }
+    let (fq, fw) = (
+        number(&quarter, "punch_force_peak_n"),
+        number(&whole, "punch_force_peak_n"),
+    );
+    assert!(fq > 0.0 && (fq - fw).abs() < 1e-8 * fq, "{fq} vs {fw}");
+    for key in ["d0", "d45", "d90"] {
+        let (a, b) = (
+            number(&quarter["final_draw_in"], key),
+            number(&whole["final_draw_in"], key),
+        );
+        assert!((a - b).abs() < 1e-9, "{key}: {a} vs {b}");
+    }
 }
