@@ -75,3 +75,47 @@ pub fn register(engine: &mut Engine, limits: super::limits::Limits) {
         lift(Mesh::round_blank(&blank))
     });
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::mesh::Mesh;
+    use crate::script::{engine, HostOptions};
+
+    fn eval(src: &str) -> Result<Mesh, String> {
+        engine(&HostOptions::default(), None)
+            .eval::<Mesh>(src)
+            .map_err(|e| e.to_string())
+    }
+
+    /// Defaults follow the keys given (transition rows = core cells; circles from twice
+    /// the core size); the quarter has the symmetry-plane sets; bad keys and values are
+    /// named.
+    #[test]
+    fn round_blank_from_a_script() {
+        let m = eval("round_blank(#{ radius: 50, thickness: 1.0, quarter: true, core_cells: 2, core_size: 5.0, ring_cells: 3 })")
+            .unwrap();
+        // Core 3 x 3 points, 5 rays x (2 transition + 3 ring) rows, 2 layers of points.
+        assert_eq!(m.node_count(), (9 + 5 * 5) * 2);
+        assert!(m.node_set("x-").is_ok() && m.node_set("rim").is_ok());
+        let rim_at = m.node_set("rim").unwrap()[0];
+        assert!((m.nodes[rim_at].x.hypot(m.nodes[rim_at].y) - 50.0).abs() < 1e-12);
+
+        let e = eval("round_blank(#{ radius: 50.0 })").unwrap_err();
+        assert!(e.contains("round_blank needs the key `thickness`"), "{e}");
+        let e = eval("round_blank(#{ radius: 50.0, thickness: 1.0, cells: 3 })").unwrap_err();
+        assert!(e.contains("unknown key `cells`"), "{e}");
+        let e = eval("round_blank(#{ radius: 50.0, thickness: 1.0, layers: 0 })").unwrap_err();
+        assert!(e.contains("round_blank.layers = 0 must be >= 1"), "{e}");
+        let e =
+            eval("round_blank(#{ radius: 50.0, thickness: 1.0, core_cells: 2.5 })").unwrap_err();
+        assert!(e.contains("core_cells must be an integer"), "{e}");
+        let e = eval("round_blank(#{ radius: 50.0, thickness: 1.0, quarter: 1 })").unwrap_err();
+        assert!(e.contains("quarter must be true or false"), "{e}");
+        let e =
+            eval("round_blank(#{ radius: 50.0, thickness: 1.0, round_radius: 80.0 })").unwrap_err();
+        assert!(
+            e.contains("round_radius = 80 must be < the radius 50"),
+            "{e}"
+        );
+    }
+}
