@@ -6,9 +6,6 @@ use crate::{Error, Result};
 
 /// Halvings of the line search (smallest step 1/16 of the Newton step).
 const LINE_SEARCH_CUTS: usize = 4;
-/// Further halvings when no trial of the backtracking is admissible (smallest step
-/// 2^-16 of the last trial).
-const ADMISSIBLE_CUTS: usize = 16;
 
 impl Simulation {
     /// Backtracking (Armijo) line search on the merit function |R|: the step `alpha dx` with
@@ -68,14 +65,6 @@ impl Simulation {
             }
             alpha *= 0.5;
         }
-        if best.is_none() {
-            // Every trial down to alpha0/16 was inadmissible (an element turned inside out,
-            // a material state out of range): the step is far too long, not wrong in
-            // direction, so it is shortened until the state is admissible again.
-            if let Some((xn, e)) = self.admissible_fraction(ctx, &trial_x, alpha, times) {
-                best = Some((0.0, xn, e));
-            }
-        }
         match (best, last_err) {
             (Some((_, xn, e)), _) => {
                 let e = ctx.complete(&xn, e, times)?;
@@ -86,28 +75,5 @@ impl Simulation {
                 "non-finite residual at every line-search step".into(),
             )),
         }
-    }
-
-    /// The first admissible trial `trial_x(alpha)` for alpha halved from `alpha` down to
-    /// 2^-ADMISSIBLE_CUTS of it (residual-only evaluations, then one whole evaluation of
-    /// the one kept), or `None`. Runs only where the ordinary backtracking found no
-    /// admissible trial at all, so it changes no run that converged before. O(ADMISSIBLE_CUTS)
-    /// residual evaluations at most.
-    fn admissible_fraction(
-        &self,
-        ctx: &IncrementContext<'_>,
-        trial_x: &dyn Fn(f64) -> Vec<f64>,
-        mut alpha: f64,
-        times: &mut PhaseTimes,
-    ) -> Option<(Vec<f64>, Evaluation)> {
-        for _ in 0..ADMISSIBLE_CUTS {
-            let xn = trial_x(alpha);
-            if ctx.evaluate_residual(&xn, times).is_ok() {
-                let e = ctx.evaluate(&xn, times).ok()?;
-                return Some((xn, e));
-            }
-            alpha *= 0.5;
-        }
-        None
     }
 }

@@ -1,6 +1,7 @@
 //! First iterates of an increment's Newton solve: the extrapolating predictor (the last
-//! increment's motion continued) and the linearised Dirichlet predictor (prescribed jumps
-//! spread over the body by one tangent solve).
+//! increment's motion continued), the linearised Dirichlet predictor (prescribed jumps
+//! spread over the body by one tangent solve) and the seating of force-controlled tools
+//! that touch nothing at the first iterate.
 
 use super::assembly::{Evaluation, IncrementContext, PhaseTimes};
 use super::force_control;
