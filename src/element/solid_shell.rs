@@ -394,7 +394,6 @@ pub(super) fn samples(q: usize, c: usize) -> ([(usize, f64); 4], usize) {
     }
 }
 
-
 /// What one integration point keeps between the local iterations and the assembly.
 struct Point {
     /// Cartesian Green-Lagrange strain from the displacements alone (engineering shear).
@@ -791,9 +790,10 @@ impl Element<DOFS> for SolidShell {
             for m in ne..ENHANCED_PARAMETERS {
                 k_aa[(m, m)] = 1.0;
             }
-            let step = k_aa.lu().solve(&r_a).ok_or_else(|| {
-                Error::NoConvergence("singular enhanced-strain stiffness".into())
-            })?;
+            let step = k_aa
+                .lu()
+                .solve(&r_a)
+                .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))?;
             let size = step.amax();
             let scale = strain_scale.max(alpha.amax());
             // Converged, or stalled at round-off (the step no longer shrinks).
