@@ -459,8 +459,16 @@ fn tuned_kernel_equals_the_original() {
                     t.enhanced = s.enhanced;
                 }
                 let (mut f, mut k) = (vec![0.0; 24], vec![0.0; 576]);
-                el.evaluate_into(&x, &at(1.0), &committed, &mut trial, m, &mut f, Some(&mut k))
-                    .unwrap();
+                el.evaluate_into(
+                    &x,
+                    &at(1.0),
+                    &committed,
+                    &mut trial,
+                    m,
+                    &mut f,
+                    Some(&mut k),
+                )
+                .unwrap();
                 let mut trial_ref = committed.clone();
                 let (mut f_ref, mut k_ref) = (vec![0.0; 24], vec![0.0; 576]);
                 tribo::element::solid_shell_reference::evaluate_into(

@@ -394,7 +394,6 @@ pub(super) fn samples(q: usize, c: usize) -> ([(usize, f64); 4], usize) {
     }
 }
 
-
 /// What one integration point keeps between the local iterations and the assembly.
 struct Point {
     /// Cartesian Green-Lagrange strain from the displacements alone (engineering shear).
@@ -453,6 +452,21 @@ pub(super) fn cholesky_excess(a: &Mat3) -> Result<Mat3> {
         }
     }
     Ok(h)
+}
+
+/// `K_αα⁻¹ rhs` for the `ne` active enhanced parameters (identity rows for the inactive
+/// ones, whose modes and right-hand sides are zero).
+fn solve_enhanced<const C: usize>(
+    mut k_aa: SMatrix<f64, ENHANCED_PARAMETERS, ENHANCED_PARAMETERS>,
+    ne: usize,
+    rhs: &SMatrix<f64, ENHANCED_PARAMETERS, C>,
+) -> Result<SMatrix<f64, ENHANCED_PARAMETERS, C>> {
+    for m in ne..ENHANCED_PARAMETERS {
+        k_aa[(m, m)] = 1.0;
+    }
+    k_aa.lu()
+        .solve(rhs)
+        .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))
 }
 
 /// The through-thickness rule of `n` points, computed once per `n`.
@@ -787,13 +801,7 @@ impl Element<DOFS> for SolidShell {
                 stresses[p] = s;
                 tangents[p] = c;
             }
-            // Inactive parameters: identity rows, zero residual.
-            for m in ne..ENHANCED_PARAMETERS {
-                k_aa[(m, m)] = 1.0;
-            }
-            let step = k_aa.lu().solve(&r_a).ok_or_else(|| {
-                Error::NoConvergence("singular enhanced-strain stiffness".into())
-            })?;
+            let step = solve_enhanced(k_aa, ne, &r_a)?;
             let size = step.amax();
             let scale = strain_scale.max(alpha.amax());
             // Converged, or stalled at round-off (the step no longer shrinks).
@@ -836,13 +844,7 @@ impl Element<DOFS> for SolidShell {
         if self.finite {
             self.add_geometric(&points, &levels, &stresses[..np], &mut k);
         }
-        for m in ne..ENHANCED_PARAMETERS {
-            k_aa[(m, m)] = 1.0;
-        }
-        let correction = k_aa
-            .lu()
-            .solve(&k_au)
-            .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))?;
+        let correction = solve_enhanced(k_aa, ne, &k_au)?;
         k.gemm(-1.0, &k_ua, &correction, 1.0);
         k_out.copy_from_slice(k.as_slice());
         Ok(())

@@ -335,10 +335,11 @@ pub fn evaluate_into(
             stresses[p] = s;
             tangents[p] = c;
         }
-        let step =
-            k_aa.clone().lu().solve(&r_a).ok_or_else(|| {
-                Error::NoConvergence("singular enhanced-strain stiffness".into())
-            })?;
+        let step = k_aa
+            .clone()
+            .lu()
+            .solve(&r_a)
+            .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))?;
         let size = step.amax();
         let scale = strain_scale.max(alpha.iter().fold(0.0, |m, a| m.max(a.abs())));
         // Converged, or stalled at round-off (the step no longer shrinks).

@@ -470,7 +470,12 @@ impl IncrementContext<'_> {
         }
         times.elements += t0.elapsed().as_secs_f64();
 
-        let f_ext = model.external_forces(self.time);
+        let mut f_ext = model.external_forces(self.time);
+        for load in &model.follower_loads {
+            let mut add = |r: usize, c: usize, v: f64| jac.add(r, c, -v);
+            let stiffness = with_jacobian.then_some(&mut add as &mut dyn FnMut(usize, usize, f64));
+            load.add_forces(&model.mesh, x, self.time, &mut f_ext, stiffness);
+        }
         for d in 0..3 * self.dofs.n_nodes {
             residual[d] = f_int[d] - f_ext[d];
         }

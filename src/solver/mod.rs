@@ -6,6 +6,7 @@ pub mod checkpoint;
 pub mod condense;
 pub mod cycling;
 pub mod energy;
+pub mod follower_load;
 pub mod force_control;
 pub mod line_search;
 pub mod linear;

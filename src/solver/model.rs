@@ -117,6 +117,8 @@ pub struct Model {
     pub material: Arc<dyn Material>,
     pub dirichlet: Vec<Dirichlet>,
     pub loads: Vec<NodalLoad>,
+    /// Loads that turn with the surface (`solver::follower_load`).
+    pub follower_loads: Vec<super::follower_load::FollowerTraction>,
     pub contacts: Vec<ToolContact>,
     pub settings: SolverSettings,
 }
@@ -129,6 +131,7 @@ impl Model {
             material,
             dirichlet: Vec::new(),
             loads: Vec::new(),
+            follower_loads: Vec::new(),
             contacts: Vec::new(),
             settings: SolverSettings::default(),
         })
