@@ -570,7 +570,8 @@ impl Condenser {
             t.clear();
             t.extend((0..w).map(|i| {
                 let row = e.local_row(i);
-                let terms = &self.back_terms[self.back_ptr[local + i]..self.back_ptr[local + i + 1]];
+                let terms =
+                    &self.back_terms[self.back_ptr[local + i]..self.back_ptr[local + i + 1]];
                 let n_du: f64 = terms.iter().map(|&(col, k)| j.values[k] * dx[col]).sum();
                 -residual[row] - n_du
             }));
