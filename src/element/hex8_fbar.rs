@@ -241,7 +241,8 @@ impl PointKernel<'_> {
         // The H term of entry (i, j) = ((a, kk), (c, l)) is `h g_a,l g_c,kk - h g⁰_a,l g⁰_c,kk`:
         // per column, two products of 24-vectors, `hg[l][i] = h g_a,l` and
         // `gc[c][i] = g_c,kk` (the same products in the same order as entry by entry).
-        let hg: [[f64; DOFS]; 3] = std::array::from_fn(|l| std::array::from_fn(|i| h * g[i / 3][l]));
+        let hg: [[f64; DOFS]; 3] =
+            std::array::from_fn(|l| std::array::from_fn(|i| h * g[i / 3][l]));
         let hg0: [[f64; DOFS]; 3] =
             std::array::from_fn(|l| std::array::from_fn(|i| h * g0[i / 3][l]));
         for c in 0..NODES {
@@ -255,10 +256,8 @@ impl PointKernel<'_> {
                 let (hgl, hg0l) = (&hg[l], &hg0[l]);
                 for i in 0..DOFS {
                     let bb = z0[i] * b[c][0] + z1[i] * b[c][1] + z2[i] * b[c][2];
-                    col[i] += r2dv * bb
-                        + alpha[i] * qj
-                        + q[i] * bj
-                        + (hgl[i] * gc[i] - hg0l[i] * g0c[i]);
+                    col[i] +=
+                        r2dv * bb + alpha[i] * qj + q[i] * bj + (hgl[i] * gc[i] - hg0l[i] * g0c[i]);
                 }
             }
         }

@@ -788,7 +788,11 @@ mod tests {
             // without a contact pass).
             let completions = times.jacobian_completions;
             let completed = ctx
-                .complete(&x, ctx.evaluate_residual(&x, &mut times).unwrap(), &mut times)
+                .complete(
+                    &x,
+                    ctx.evaluate_residual(&x, &mut times).unwrap(),
+                    &mut times,
+                )
                 .unwrap();
             assert_eq!(
                 times.jacobian_completions,

@@ -140,6 +140,13 @@ pub struct Condenser {
     /// The slot plan: the reduced matrix's value index of every contribution, in the order
     /// of [`Self::walk`] (u32: the reduced pattern has fewer than 2^32 entries).
     slots: Vec<u32>,
+    /// The back-substitution's `N du` terms, (column, value position) of every kept column
+    /// of each eliminated node's local rows, node after node and row after row (the
+    /// entries of `rows` that are not eliminated multipliers, listed once instead of
+    /// filtered per solve); local row `r` in that order owns
+    /// `back_terms[back_ptr[r]..back_ptr[r + 1]]`.
+    back_terms: Vec<(usize, usize)>,
+    back_ptr: Vec<usize>,
     /// Calls solved through the mixed system because no local elimination existed.
     fallbacks: AtomicUsize,
 }
@@ -294,8 +301,19 @@ impl Condenser {
             condensed_row,
             owner,
             slots: Vec::new(),
+            back_terms: Vec::new(),
+            back_ptr: vec![0],
             fallbacks: AtomicUsize::new(0),
         };
+        for e in &condenser.nodes {
+            for i in 0..e.width() {
+                let kept = condenser.rows[e.local_row(i)]
+                    .iter()
+                    .filter(|&&(col, _)| condenser.reduced_index[col].is_some());
+                condenser.back_terms.extend(kept);
+                condenser.back_ptr.push(condenser.back_terms.len());
+            }
+        }
         // Record the plan: the walk only depends on the pattern, so zero values will do.
         let zeros = vec![0.0; full.nnz()];
         let coefficients = condenser
@@ -546,18 +564,18 @@ impl Condenser {
         }
         // Back-substitution: dl = H (rhs_local - N du), N over the reduced columns.
         let mut t = Vec::new();
+        let mut local = 0;
         for e in &self.nodes {
             let w = e.width();
             t.clear();
             t.extend((0..w).map(|i| {
                 let row = e.local_row(i);
-                let n_du: f64 = self.rows[row]
-                    .iter()
-                    .filter(|&&(col, _)| self.reduced_index[col].is_some())
-                    .map(|&(col, k)| j.values[k] * dx[col])
-                    .sum();
+                let terms =
+                    &self.back_terms[self.back_ptr[local + i]..self.back_ptr[local + i + 1]];
+                let n_du: f64 = terms.iter().map(|&(col, k)| j.values[k] * dx[col]).sum();
                 -residual[row] - n_du
             }));
+            local += w;
             let c = &coefficients[e.offset..e.offset + w * w];
             for (p, pair) in e.pairs.iter().enumerate() {
                 for beta in 0..3 {
