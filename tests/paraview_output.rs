@@ -1,6 +1,6 @@
 //! What ParaView opens: frames.pvd lists, at every time, the blank (points in the current
-//! configuration, displacement alongside, named stress components) and the patch tools at
-//! their scheduled pose; frames follow the output cadence, and a rollback rewrites the
+//! configuration, displacement alongside, named stress components) and the tools (patch and
+//! analytic) at their scheduled pose; frames follow the output cadence, and a rollback rewrites the
 //! series to the kept frames. Files are read back with an XML parser (quick-xml) and
 //! tribo's VTU reader, independently of how they were written.
 
@@ -116,10 +116,12 @@ fn frames_show_the_deformed_blank_and_the_tools_at_their_pose() {
     let entries = pvd_entries(&out.join("frames.pvd"));
     let t = times(&entries);
     assert_eq!(t, vec![0.0, 0.25, 0.5, 0.75, 1.0], "{entries:?}");
-    // Each time: the blank (part 0) and the punch (part 1); the floor plane has no surface.
+    // Each time: the blank (part 0), the punch (part 1) and the floor plane (part 2).
     for (k, &time) in t.iter().enumerate() {
         let parts: Vec<&Entry> = entries.iter().filter(|e| e.0 == time).collect();
-        assert_eq!(parts.len(), 2, "{parts:?}");
+        assert_eq!(parts.len(), 3, "{parts:?}");
+        assert_eq!((parts[2].1, parts[2].2.as_str()), (2, "floor"));
+        assert_eq!(parts[2].3, format!("frames/frame_{k:04}_floor.vtu"));
         assert_eq!(
             (parts[0].1, parts[0].3.as_str()),
             (0, format!("frames/frame_{k:04}.vtu").as_str())
@@ -160,6 +162,21 @@ fn frames_show_the_deformed_blank_and_the_tools_at_their_pose() {
         }
     }
     assert!(moved > 1e-3, "the blank deforms: largest |u| {moved}");
+    // The floor plane (z = 0, not moving): the square of half side the blank box's half
+    // diagonal sqrt(4^2 + 4^2 + 1) / 2 about (2, 2, 0), the same in every frame.
+    let half = 33f64.sqrt() / 2.0;
+    let floor0 = read_vtu(&out.join("frames/frame_0000_floor.vtu")).unwrap();
+    assert_eq!(floor0.quads.len(), 1);
+    for p in &floor0.points {
+        assert_eq!(p[2], 0.0);
+        for c in 0..2 {
+            assert!(((p[c] - 2.0).abs() - half).abs() < 1e-12, "{p:?}");
+        }
+    }
+    for k in 1..t.len() {
+        let floor = read_vtu(&out.join(format!("frames/frame_{k:04}_floor.vtu"))).unwrap();
+        assert_eq!(floor.points, floor0.points);
+    }
     // At t = 0 the punch is the patch itself: its corner (-1, -1, 1.02).
     assert!(punch0.points.iter().any(|p| p == &[-1.0, -1.0, 1.02]));
 
@@ -249,7 +266,7 @@ fn rollback_rewrites_the_series_to_the_kept_frames() {
     let entries = pvd_entries(&out.join("frames.pvd"));
     // Frames at 0, 0.25, 0.5, 0.75; back to 0.25; one step to 0.5 again.
     assert_eq!(times(&entries), vec![0.0, 0.25, 0.5]);
-    assert_eq!(entries.len(), 6, "blank and punch at each kept time");
+    assert_eq!(entries.len(), 9, "blank, punch and floor at each kept time");
     for e in &entries {
         assert!(out.join(&e.3).is_file(), "{e:?}");
     }
