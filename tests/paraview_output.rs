@@ -379,3 +379,51 @@ fn field_maps_split_by_tool_on_the_law_range() {
     assert!(svg.contains(">x [mm]</text>") && svg.contains(">y [mm]</text>"));
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
+
+/// The square cup's frames.pvd (scripts/square_cup.rhai, 4 x 4 cells, 2 mm of travel), read
+/// back as XML: at every time the blank and the punch, die and blankholder, each tool placed
+/// at the schedule's pose: the punch moved down by the travel (the pseudo-time), the holder
+/// up by its opening 0.5 mm / 30 mm of travel, the die still.
+#[test]
+fn the_cups_frames_hold_every_tool_at_its_scheduled_pose() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::env::temp_dir().join(format!("tribo-paraview-cup-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .current_dir(root)
+        .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
+        .arg(&out)
+        .args(["--set", "cells=4", "--set", "travel=2.0", "--set", "charts=false"])
+        .status()
+        .expect("tribo runs");
+    assert!(status.success());
+    let entries = pvd_entries(&out.join("frames.pvd"));
+    let t = times(&entries);
+    assert!(t.len() >= 3 && t[0] == 0.0 && (t[t.len() - 1] - 2.0).abs() < 1e-12, "{t:?}");
+    let names = ["blank", "punch", "die", "blankholder"];
+    let shift = |name: &str, time: f64| match name {
+        "punch" => -time,
+        "blankholder" => 0.5 / 30.0 * time,
+        _ => 0.0,
+    };
+    for (k, &time) in t.iter().enumerate() {
+        let parts: Vec<&Entry> = entries.iter().filter(|e| e.0 == time).collect();
+        let got: Vec<&str> = parts.iter().map(|e| e.2.as_str()).collect();
+        assert_eq!(got, names, "time {time}");
+        for (part, e) in parts.iter().enumerate().skip(1) {
+            assert_eq!(e.1, part);
+            let first = entries.iter().find(|f| f.0 == 0.0 && f.1 == part).unwrap();
+            let (now, then) = (
+                read_vtu(&out.join(&e.3)).unwrap(),
+                read_vtu(&out.join(&first.3)).unwrap(),
+            );
+            assert!(!now.quads.is_empty() && now.quads == then.quads, "{e:?}");
+            let dz = shift(&e.2, time);
+            for (p, p0) in now.points.iter().zip(&then.points) {
+                assert_eq!([p[0], p[1]], [p0[0], p0[1]], "frame {k} {}", e.2);
+                assert!((p[2] - p0[2] - dz).abs() < 1e-12, "frame {k} {}: {p:?}", e.2);
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
