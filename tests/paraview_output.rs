@@ -381,7 +381,7 @@ fn field_maps_split_by_tool_on_the_law_range() {
 }
 
 /// The square cup's frames.pvd (scripts/square_cup.rhai, 4 x 4 cells, 2 mm of travel), read
-/// back as XML: at every time the blank and the punch, die and blankholder, each tool placed
+/// back as XML: at every time the blank and the punch, blankholder and die, each tool placed
 /// at the schedule's pose: the punch moved down by the travel (the pseudo-time), the holder
 /// up by its opening 0.5 mm / 30 mm of travel, the die still.
 #[test]
@@ -400,7 +400,7 @@ fn the_cups_frames_hold_every_tool_at_its_scheduled_pose() {
     let entries = pvd_entries(&out.join("frames.pvd"));
     let t = times(&entries);
     assert!(t.len() >= 3 && t[0] == 0.0 && (t[t.len() - 1] - 2.0).abs() < 1e-12, "{t:?}");
-    let names = ["blank", "punch", "die", "blankholder"];
+    let names = ["blank", "punch", "blankholder", "die"];
     let shift = |name: &str, time: f64| match name {
         "punch" => -time,
         "blankholder" => 0.5 / 30.0 * time,
