@@ -158,14 +158,7 @@ impl Iges<'_> {
 
     /// The model-space curve of the 142 at `pointer` (named from `face`).
     fn model_loop(&self, pointer: i64, face: &Params) -> Result<Loop> {
-        let c = self.entry(pointer, face, "boundary")?;
-        if c.kind != 142 {
-            return Err(face.fail(format!(
-                "its boundary pointer names {}, not a 142 curve on surface",
-                Self::describe(c)
-            )));
-        }
-        let p = self.params(c)?;
+        let p = self.curve_on_surface(pointer, face)?;
         let curve = p.int(4, "CPTR, model-space curve pointer")?;
         if curve == 0 {
             return Err(p.fail(
