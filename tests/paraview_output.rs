@@ -393,13 +393,23 @@ fn the_cups_frames_hold_every_tool_at_its_scheduled_pose() {
         .current_dir(root)
         .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
         .arg(&out)
-        .args(["--set", "cells=4", "--set", "travel=2.0", "--set", "charts=false"])
+        .args([
+            "--set",
+            "cells=4",
+            "--set",
+            "travel=2.0",
+            "--set",
+            "charts=false",
+        ])
         .status()
         .expect("tribo runs");
     assert!(status.success());
     let entries = pvd_entries(&out.join("frames.pvd"));
     let t = times(&entries);
-    assert!(t.len() >= 3 && t[0] == 0.0 && (t[t.len() - 1] - 2.0).abs() < 1e-12, "{t:?}");
+    assert!(
+        t.len() >= 3 && t[0] == 0.0 && (t[t.len() - 1] - 2.0).abs() < 1e-12,
+        "{t:?}"
+    );
     let names = ["blank", "punch", "blankholder", "die"];
     let shift = |name: &str, time: f64| match name {
         "punch" => -time,
@@ -421,7 +431,11 @@ fn the_cups_frames_hold_every_tool_at_its_scheduled_pose() {
             let dz = shift(&e.2, time);
             for (p, p0) in now.points.iter().zip(&then.points) {
                 assert_eq!([p[0], p[1]], [p0[0], p0[1]], "frame {k} {}", e.2);
-                assert!((p[2] - p0[2] - dz).abs() < 1e-12, "frame {k} {}: {p:?}", e.2);
+                assert!(
+                    (p[2] - p0[2] - dz).abs() < 1e-12,
+                    "frame {k} {}: {p:?}",
+                    e.2
+                );
             }
         }
     }

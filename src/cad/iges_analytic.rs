@@ -99,10 +99,7 @@ impl Iges<'_> {
                     xyz,
                     range,
                 } = bspline_curve(&p)?;
-                let points = xyz
-                    .chunks(3)
-                    .map(|c| Vec3::new(c[0], c[1], c[2]))
-                    .collect();
+                let points = xyz.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
                 NurbsCurve::new(degree, knots, points, weights, range)
             }
             _ => {
@@ -197,8 +194,7 @@ impl Iges<'_> {
         let curve = p.int(5, "PTR, bounding curve pointer")?;
         if curve == 0 {
             return Err(p.fail(
-                "an unbounded plane is not a face: bound it (form 1) or trim it (144)"
-                    .to_string(),
+                "an unbounded plane is not a face: bound it (form 1) or trim it (144)".to_string(),
             ));
         }
         let bound = self.model_segments(self.entry(curve, &p, "bounding curve")?, 0)?;

@@ -422,7 +422,12 @@ impl<'a> Step<'a> {
         }
     }
 
-    pub(super) fn list<'v>(&self, id: usize, v: Option<&'v Value>, what: &str) -> Result<&'v [Value]> {
+    pub(super) fn list<'v>(
+        &self,
+        id: usize,
+        v: Option<&'v Value>,
+        what: &str,
+    ) -> Result<&'v [Value]> {
         match v {
             Some(Value::List(l)) => Ok(l),
             _ => Err(self.fail(id, format!("its {what} is not a list"))),

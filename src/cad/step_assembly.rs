@@ -51,7 +51,9 @@ impl Step<'_> {
                     let p = self.part(t, "ITEM_DEFINED_TRANSFORMATION").ok_or_else(|| {
                         self.fail(
                             id,
-                            format!("its transformation #{t} is not an ITEM_DEFINED_TRANSFORMATION"),
+                            format!(
+                                "its transformation #{t} is not an ITEM_DEFINED_TRANSFORMATION"
+                            ),
                         )
                     })?;
                     let from = self.axis_placement(self.reference(t, p.get(2), "item_1")?, t)?;
@@ -90,7 +92,9 @@ impl Step<'_> {
                 }
             }
             for f in faces {
-                out.entry(f).or_insert_with(Vec::new).extend(poses.iter().copied());
+                out.entry(f)
+                    .or_insert_with(Vec::new)
+                    .extend(poses.iter().copied());
             }
         }
         Ok(out)
@@ -142,7 +146,9 @@ impl Step<'_> {
                     out.push(id);
                     return;
                 }
-                "MANIFOLD_SOLID_BREP" | "SHELL_BASED_SURFACE_MODEL" | "CLOSED_SHELL"
+                "MANIFOLD_SOLID_BREP"
+                | "SHELL_BASED_SURFACE_MODEL"
+                | "CLOSED_SHELL"
                 | "OPEN_SHELL" => refs(p.get(1)),
                 "BREP_WITH_VOIDS" => [refs(p.get(1)), refs(p.get(2))].concat(),
                 _ => continue,
@@ -159,7 +165,10 @@ impl Step<'_> {
     /// module docs); defaults `axis = z`, `ref_direction = x`.
     fn axis_placement(&self, id: usize, from: usize) -> Result<Pose> {
         let p = self.part(id, "AXIS2_PLACEMENT_3D").ok_or_else(|| {
-            self.fail(from, format!("its placement #{id} is not an AXIS2_PLACEMENT_3D"))
+            self.fail(
+                from,
+                format!("its placement #{id} is not an AXIS2_PLACEMENT_3D"),
+            )
         })?;
         let location = self.point(self.reference(id, p.get(1), "location")?, id)?;
         let direction = |v: Option<&Value>, default: Vec3| -> Result<Vec3> {

@@ -86,11 +86,17 @@ pub trait RigidSurface: std::fmt::Debug {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum AnalyticShape {
     /// Outward `normal`.
-    Plane { point: Vec3, normal: Vec3 },
+    Plane {
+        point: Vec3,
+        normal: Vec3,
+    },
     Cylinder {
         axis_point: Vec3,
         axis: Vec3,
         radius: f64,
     },
-    Sphere { centre: Vec3, radius: f64 },
+    Sphere {
+        centre: Vec3,
+        radius: f64,
+    },
 }

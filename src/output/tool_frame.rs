@@ -200,7 +200,10 @@ mod tests {
     fn analytic_tools_are_shown_on_their_exact_surface() {
         use crate::geometry::{Cylinder, Plane, RigidSurface, Sphere};
         let region = DisplayRegion::around(&[Vec3::new(0.0, 0.0, 0.0), Vec3::new(8.0, 6.0, 0.0)]);
-        assert_eq!((region.centre, region.half), (Vec3::new(4.0, 3.0, 0.0), 5.0));
+        assert_eq!(
+            (region.centre, region.half),
+            (Vec3::new(4.0, 3.0, 0.0), 5.0)
+        );
         let pose = Pose::about_axis(
             &Vec3::new(1.0, 0.0, 0.0),
             &Vec3::new(0.3, 0.0, 1.0),
@@ -209,7 +212,9 @@ mod tests {
         );
         let surfaces: Vec<Arc<dyn RigidSurface>> = vec![
             Arc::new(Plane::new(Vec3::new(0.0, 0.0, 2.0), Vec3::new(0.0, 1.0, 1.0)).unwrap()),
-            Arc::new(Cylinder::new(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 1.0, 0.0), 2.5).unwrap()),
+            Arc::new(
+                Cylinder::new(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 1.0, 0.0), 2.5).unwrap(),
+            ),
             Arc::new(Sphere::new(Vec3::new(-1.0, 0.0, 4.0), 1.5).unwrap()),
         ];
         for surface in surfaces {
@@ -221,13 +226,22 @@ mod tests {
             for (k, x) in f.points.iter().enumerate() {
                 let local = pose.to_local(&Vec3::from(*x));
                 let p = surface.project(&local, None).unwrap();
-                assert!(p.gap.abs() < 1e-12, "{}: {x:?} off by {}", surface.describe(), p.gap);
+                assert!(
+                    p.gap.abs() < 1e-12,
+                    "{}: {x:?} off by {}",
+                    surface.describe(),
+                    p.gap
+                );
                 let n = Vec3::new(normals[3 * k], normals[3 * k + 1], normals[3 * k + 2]);
                 if n.norm() > 0.0 {
                     let exact = pose.to_global_vector(&p.normal);
                     // 1e-9: by the sphere's poles one tangent is 1e-4 times the other, which
                     // amplifies the round-off of their cross product.
-                    assert!((n - exact).norm() < 1e-9, "{}: {n} vs {exact}", surface.describe());
+                    assert!(
+                        (n - exact).norm() < 1e-9,
+                        "{}: {n} vs {exact}",
+                        surface.describe()
+                    );
                 }
                 let along = (local - region.centre).dot(&Vec3::y());
                 lo = lo.min(along);
@@ -235,7 +249,10 @@ mod tests {
             }
             // Plane and cylinder: over the region's extent along y (the cylinder's axis).
             if surface.describe().starts_with("cylinder") {
-                assert!((lo + 5.0).abs() < 1e-12 && (hi - 5.0).abs() < 1e-12, "{lo} {hi}");
+                assert!(
+                    (lo + 5.0).abs() < 1e-12 && (hi - 5.0).abs() < 1e-12,
+                    "{lo} {hi}"
+                );
             }
             assert!(!f.quads.is_empty() && hi > lo, "{}", surface.describe());
         }
