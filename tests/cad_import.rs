@@ -411,3 +411,31 @@ fn bad_step_files_are_refused_naming_what_and_where() {
     let e = step_refusal("notes.step", "punch and die\n");
     assert!(e.contains("notes.step:1: no DATA section"), "{e}");
 }
+
+/// The punch placed in an assembly (tests/data/cad/punch_assembly.step: OCC's XCAF writer,
+/// the part rotated by 30 degrees about z then moved by (5, -3, 2.5)) imports at that pose:
+/// it equals the builder's punch moved the same way, at 10^4 points.
+#[test]
+fn a_part_placed_in_a_step_assembly_imports_at_its_pose() {
+    let imported = step_tool("punch_assembly.step");
+    let (s, c) = 30f64.to_radians().sin_cos();
+    let rotation = tribo::geometry::Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+    let shift = Vec3::new(5.0, -3.0, 2.5);
+    let placed: Vec<_> = punch_patches(&PunchSpec::numisheet93(0.0), Extent::Full)
+        .unwrap()
+        .iter()
+        .map(|p| p.transformed(&rotation, &shift))
+        .collect();
+    let reference = PatchSurface::new(placed).unwrap();
+    let points = points_around(&reference, 10_000, 95, |p| p.z < 40.0 + 2.5);
+    let worst = worst_difference(&imported, &reference, &points);
+    eprintln!("punch placed in an assembly (step): worst foot, normal, gap {worst:?}");
+    // The part's own faces, unplaced, are elsewhere.
+    let unplaced = step_tool("punch_nurbs.step");
+    let x = Vec3::new(40.0, 0.0, 20.0);
+    let (a, b) = (
+        imported.project(&x, None).unwrap(),
+        unplaced.project(&x, None).unwrap(),
+    );
+    assert!((a.foot - b.foot).norm() > 1.0, "{a:?} {b:?}");
+}

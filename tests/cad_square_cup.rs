@@ -16,12 +16,7 @@ fn run(tag: &str, extra: &[&str]) -> Value {
         .current_dir(root)
         .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
         .arg(&out)
-        .args([
-            "--set",
-            "travel=6.0",
-            "--set",
-            "charts=false",
-        ])
+        .args(["--set", "travel=6.0", "--set", "charts=false"])
         .args(extra)
         .status()
         .expect("tribo runs");
@@ -81,7 +76,13 @@ fn gmsh_blank_gives_the_block_draw_in_and_punch_force() {
             "tests/data/mesh",
         ],
     );
-    for key in ["status", "nodes", "elements", "increments", "newton_iterations"] {
+    for key in [
+        "status",
+        "nodes",
+        "elements",
+        "increments",
+        "newton_iterations",
+    ] {
         assert_eq!(block[key], gmsh[key], "{key}");
     }
     assert_eq!(block["nodes"], 2 * 11 * 11);

@@ -18,11 +18,15 @@ fn a_run_writes_frames_history_and_summary() {
     script::run_file(&script, &[], &host).unwrap();
 
     let pvd = std::fs::read_to_string(out.join("frames.pvd")).unwrap();
-    assert_eq!(
-        pvd.matches("<DataSet").count(),
-        5,
-        "initial frame + 4 increments:\n{pvd}"
-    );
+    // The blank and the floor plane tool at each time.
+    for part in ["name=\"blank\"", "name=\"floor\""] {
+        assert_eq!(
+            pvd.matches(part).count(),
+            5,
+            "{part}: initial frame + 4 increments:\n{pvd}"
+        );
+    }
+    assert_eq!(pvd.matches("<DataSet").count(), 10, "{pvd}");
 
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
     let lines: Vec<&str> = history.lines().collect();

@@ -1,6 +1,6 @@
 //! What ParaView opens: frames.pvd lists, at every time, the blank (points in the current
-//! configuration, displacement alongside, named stress components) and the patch tools at
-//! their scheduled pose; frames follow the output cadence, and a rollback rewrites the
+//! configuration, displacement alongside, named stress components) and the tools (patch and
+//! analytic) at their scheduled pose; frames follow the output cadence, and a rollback rewrites the
 //! series to the kept frames. Files are read back with an XML parser (quick-xml) and
 //! tribo's VTU reader, independently of how they were written.
 
@@ -116,10 +116,12 @@ fn frames_show_the_deformed_blank_and_the_tools_at_their_pose() {
     let entries = pvd_entries(&out.join("frames.pvd"));
     let t = times(&entries);
     assert_eq!(t, vec![0.0, 0.25, 0.5, 0.75, 1.0], "{entries:?}");
-    // Each time: the blank (part 0) and the punch (part 1); the floor plane has no surface.
+    // Each time: the blank (part 0), the punch (part 1) and the floor plane (part 2).
     for (k, &time) in t.iter().enumerate() {
         let parts: Vec<&Entry> = entries.iter().filter(|e| e.0 == time).collect();
-        assert_eq!(parts.len(), 2, "{parts:?}");
+        assert_eq!(parts.len(), 3, "{parts:?}");
+        assert_eq!((parts[2].1, parts[2].2.as_str()), (2, "floor"));
+        assert_eq!(parts[2].3, format!("frames/frame_{k:04}_floor.vtu"));
         assert_eq!(
             (parts[0].1, parts[0].3.as_str()),
             (0, format!("frames/frame_{k:04}.vtu").as_str())
@@ -160,6 +162,21 @@ fn frames_show_the_deformed_blank_and_the_tools_at_their_pose() {
         }
     }
     assert!(moved > 1e-3, "the blank deforms: largest |u| {moved}");
+    // The floor plane (z = 0, not moving): the square of half side the blank box's half
+    // diagonal sqrt(4^2 + 4^2 + 1) / 2 about (2, 2, 0), the same in every frame.
+    let half = 33f64.sqrt() / 2.0;
+    let floor0 = read_vtu(&out.join("frames/frame_0000_floor.vtu")).unwrap();
+    assert_eq!(floor0.quads.len(), 1);
+    for p in &floor0.points {
+        assert_eq!(p[2], 0.0);
+        for c in 0..2 {
+            assert!(((p[c] - 2.0).abs() - half).abs() < 1e-12, "{p:?}");
+        }
+    }
+    for k in 1..t.len() {
+        let floor = read_vtu(&out.join(format!("frames/frame_{k:04}_floor.vtu"))).unwrap();
+        assert_eq!(floor.points, floor0.points);
+    }
     // At t = 0 the punch is the patch itself: its corner (-1, -1, 1.02).
     assert!(punch0.points.iter().any(|p| p == &[-1.0, -1.0, 1.02]));
 
@@ -249,7 +266,7 @@ fn rollback_rewrites_the_series_to_the_kept_frames() {
     let entries = pvd_entries(&out.join("frames.pvd"));
     // Frames at 0, 0.25, 0.5, 0.75; back to 0.25; one step to 0.5 again.
     assert_eq!(times(&entries), vec![0.0, 0.25, 0.5]);
-    assert_eq!(entries.len(), 6, "blank and punch at each kept time");
+    assert_eq!(entries.len(), 9, "blank, punch and floor at each kept time");
     for e in &entries {
         assert!(out.join(&e.3).is_file(), "{e:?}");
     }
@@ -361,4 +378,66 @@ fn field_maps_split_by_tool_on_the_law_range() {
     assert!((ticks[ticks.len() - 1] - 0.11).abs() < 1e-12, "{ticks:?}");
     assert!(svg.contains(">x [mm]</text>") && svg.contains(">y [mm]</text>"));
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
+}
+
+/// The square cup's frames.pvd (scripts/square_cup.rhai, 4 x 4 cells, 2 mm of travel), read
+/// back as XML: at every time the blank and the punch, blankholder and die, each tool placed
+/// at the schedule's pose: the punch moved down by the travel (the pseudo-time), the holder
+/// up by its opening 0.5 mm / 30 mm of travel, the die still.
+#[test]
+fn the_cups_frames_hold_every_tool_at_its_scheduled_pose() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::env::temp_dir().join(format!("tribo-paraview-cup-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .current_dir(root)
+        .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
+        .arg(&out)
+        .args([
+            "--set",
+            "cells=4",
+            "--set",
+            "travel=2.0",
+            "--set",
+            "charts=false",
+        ])
+        .status()
+        .expect("tribo runs");
+    assert!(status.success());
+    let entries = pvd_entries(&out.join("frames.pvd"));
+    let t = times(&entries);
+    assert!(
+        t.len() >= 3 && t[0] == 0.0 && (t[t.len() - 1] - 2.0).abs() < 1e-12,
+        "{t:?}"
+    );
+    let names = ["blank", "punch", "blankholder", "die"];
+    let shift = |name: &str, time: f64| match name {
+        "punch" => -time,
+        "blankholder" => 0.5 / 30.0 * time,
+        _ => 0.0,
+    };
+    for (k, &time) in t.iter().enumerate() {
+        let parts: Vec<&Entry> = entries.iter().filter(|e| e.0 == time).collect();
+        let got: Vec<&str> = parts.iter().map(|e| e.2.as_str()).collect();
+        assert_eq!(got, names, "time {time}");
+        for (part, e) in parts.iter().enumerate().skip(1) {
+            assert_eq!(e.1, part);
+            let first = entries.iter().find(|f| f.0 == 0.0 && f.1 == part).unwrap();
+            let (now, then) = (
+                read_vtu(&out.join(&e.3)).unwrap(),
+                read_vtu(&out.join(&first.3)).unwrap(),
+            );
+            assert!(!now.quads.is_empty() && now.quads == then.quads, "{e:?}");
+            let dz = shift(&e.2, time);
+            for (p, p0) in now.points.iter().zip(&then.points) {
+                assert_eq!([p[0], p[1]], [p0[0], p0[1]], "frame {k} {}", e.2);
+                assert!(
+                    (p[2] - p0[2] - dz).abs() < 1e-12,
+                    "frame {k} {}: {p:?}",
+                    e.2
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&out);
 }

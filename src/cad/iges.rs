@@ -647,8 +647,8 @@ impl<'a> Iges<'a> {
         })
     }
 
-    /// A 142 curve on surface: the segments of its parameter-space curve.
-    pub(super) fn boundary(&self, pointer: i64, face: &Params) -> Result<Vec<TrimSegment>> {
+    /// The parameters of the 142 curve on surface a face's boundary `pointer` names.
+    pub(super) fn curve_on_surface(&self, pointer: i64, face: &Params) -> Result<Params<'a>> {
         let c = self.entry(pointer, face, "boundary")?;
         if c.kind != 142 {
             return Err(face.fail(format!(
@@ -656,7 +656,12 @@ impl<'a> Iges<'a> {
                 Self::describe(c)
             )));
         }
-        let p = self.params(c)?;
+        self.params(c)
+    }
+
+    /// A 142 curve on surface: the segments of its parameter-space curve.
+    fn boundary(&self, pointer: i64, face: &Params) -> Result<Vec<TrimSegment>> {
+        let p = self.curve_on_surface(pointer, face)?;
         let b = p.int(3, "BPTR, parameter-space curve pointer")?;
         if b == 0 {
             return Err(p.fail(

@@ -99,10 +99,7 @@ impl Iges<'_> {
                     xyz,
                     range,
                 } = bspline_curve(&p)?;
-                let points = xyz
-                    .chunks(3)
-                    .map(|c| Vec3::new(c[0], c[1], c[2]))
-                    .collect();
+                let points = xyz.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
                 NurbsCurve::new(degree, knots, points, weights, range)
             }
             _ => {
@@ -158,14 +155,7 @@ impl Iges<'_> {
 
     /// The model-space curve of the 142 at `pointer` (named from `face`).
     fn model_loop(&self, pointer: i64, face: &Params) -> Result<Loop> {
-        let c = self.entry(pointer, face, "boundary")?;
-        if c.kind != 142 {
-            return Err(face.fail(format!(
-                "its boundary pointer names {}, not a 142 curve on surface",
-                Self::describe(c)
-            )));
-        }
-        let p = self.params(c)?;
+        let p = self.curve_on_surface(pointer, face)?;
         let curve = p.int(4, "CPTR, model-space curve pointer")?;
         if curve == 0 {
             return Err(p.fail(
@@ -204,8 +194,7 @@ impl Iges<'_> {
         let curve = p.int(5, "PTR, bounding curve pointer")?;
         if curve == 0 {
             return Err(p.fail(
-                "an unbounded plane is not a face: bound it (form 1) or trim it (144)"
-                    .to_string(),
+                "an unbounded plane is not a face: bound it (form 1) or trim it (144)".to_string(),
             ));
         }
         let bound = self.model_segments(self.entry(curve, &p, "bounding curve")?, 0)?;

@@ -10,6 +10,7 @@ pub mod iges;
 mod iges_analytic;
 pub mod nurbs_json;
 pub mod step;
+mod step_assembly;
 
 use crate::geometry::nurbs::NurbsSurface;
 use crate::geometry::trim::{PieceTrim, TrimRegion};

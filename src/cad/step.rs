@@ -15,7 +15,8 @@
 //! refused naming it: export B-splines (OpenCascade: `BRepBuilderAPI_NurbsConvert`). The
 //! edges of a loop are chained by continuity (each one turned so that it starts where the
 //! previous ended), so a loop needs only its pcurves, not the orientation flags.
-//! Placement of parts in an assembly is not applied. Every error names the file, the line
+//! Parts placed in an assembly (`CONTEXT_DEPENDENT_SHAPE_REPRESENTATION` with an
+//! `ITEM_DEFINED_TRANSFORMATION`) come out at their placed pose ([`super::step_assembly`]). Every error names the file, the line
 //! and the instance (`#id`); the file's text is never echoed.
 
 use super::Face;
@@ -27,7 +28,7 @@ use std::collections::BTreeMap;
 
 /// A parameter of an instance.
 #[derive(Debug, Clone)]
-enum Value {
+pub(super) enum Value {
     Number(f64),
     Text(String),
     Enum(String),
@@ -41,15 +42,15 @@ enum Value {
 
 /// An instance: one or more `TYPE(params)` parts (several for a complex instance).
 #[derive(Debug)]
-struct Instance {
-    parts: Vec<(String, Vec<Value>)>,
-    line: usize,
+pub(super) struct Instance {
+    pub(super) parts: Vec<(String, Vec<Value>)>,
+    pub(super) line: usize,
 }
 
-struct Step<'a> {
-    source: &'a str,
-    instances: BTreeMap<usize, Instance>,
-    to_mm: f64,
+pub(super) struct Step<'a> {
+    pub(super) source: &'a str,
+    pub(super) instances: BTreeMap<usize, Instance>,
+    pub(super) to_mm: f64,
 }
 
 struct Lexer<'a> {
@@ -336,7 +337,7 @@ impl<'a> Step<'a> {
         Ok(step)
     }
 
-    fn fail(&self, id: usize, m: String) -> Error {
+    pub(super) fn fail(&self, id: usize, m: String) -> Error {
         let (line, kind) = self
             .instances
             .get(&id)
@@ -380,14 +381,14 @@ impl<'a> Step<'a> {
         Ok(1.0)
     }
 
-    fn instance(&self, id: usize, from: usize, what: &str) -> Result<&Instance> {
+    pub(super) fn instance(&self, id: usize, from: usize, what: &str) -> Result<&Instance> {
         self.instances
             .get(&id)
             .ok_or_else(|| self.fail(from, format!("its {what} #{id} is not defined in the file")))
     }
 
     /// Parameters of part `name` of instance `id`.
-    fn part(&self, id: usize, name: &str) -> Option<&[Value]> {
+    pub(super) fn part(&self, id: usize, name: &str) -> Option<&[Value]> {
         self.instances
             .get(&id)?
             .parts
@@ -406,14 +407,14 @@ impl<'a> Step<'a> {
         })
     }
 
-    fn reference(&self, id: usize, v: Option<&Value>, what: &str) -> Result<usize> {
+    pub(super) fn reference(&self, id: usize, v: Option<&Value>, what: &str) -> Result<usize> {
         match v {
             Some(Value::Ref(r)) => Ok(*r),
             _ => Err(self.fail(id, format!("its {what} is not an instance reference"))),
         }
     }
 
-    fn number(&self, id: usize, v: Option<&Value>, what: &str) -> Result<f64> {
+    pub(super) fn number(&self, id: usize, v: Option<&Value>, what: &str) -> Result<f64> {
         match v {
             Some(Value::Number(x)) if x.is_finite() => Ok(*x),
             Some(Value::Typed(inner)) => self.number(id, Some(inner), what),
@@ -421,7 +422,12 @@ impl<'a> Step<'a> {
         }
     }
 
-    fn list<'v>(&self, id: usize, v: Option<&'v Value>, what: &str) -> Result<&'v [Value]> {
+    pub(super) fn list<'v>(
+        &self,
+        id: usize,
+        v: Option<&'v Value>,
+        what: &str,
+    ) -> Result<&'v [Value]> {
         match v {
             Some(Value::List(l)) => Ok(l),
             _ => Err(self.fail(id, format!("its {what} is not a list"))),
@@ -437,7 +443,7 @@ impl<'a> Step<'a> {
     }
 
     /// Coordinates of a `CARTESIAN_POINT` (2 or 3 of them).
-    fn point(&self, id: usize, from: usize) -> Result<Vec<f64>> {
+    pub(super) fn point(&self, id: usize, from: usize) -> Result<Vec<f64>> {
         let p = self.part(id, "CARTESIAN_POINT").ok_or_else(|| {
             self.fail(
                 from,
@@ -715,6 +721,7 @@ impl<'a> Step<'a> {
     }
 
     fn faces(&self) -> Result<Vec<Face>> {
+        let placements = self.face_placements()?;
         let mut faces = Vec::new();
         for (&id, inst) in &self.instances {
             let Some((_, p)) = inst.parts.iter().find(|(n, _)| n == "ADVANCED_FACE") else {
@@ -737,13 +744,17 @@ impl<'a> Step<'a> {
             } else {
                 Some(TrimRegion::new(loops).map_err(|e| self.fail(id, super::strip(e)))?)
             };
-            faces.push(Face {
-                surface,
-                trim,
-                origin: format!("#{id} (ADVANCED_FACE) at line {}", inst.line),
-                flip: !same_sense,
-                arcs: [None, None],
-            });
+            let identity = [(crate::geometry::Mat3::identity(), Vec3::zeros())];
+            let poses = placements.get(&id).map_or(&identity[..], |p| &p[..]);
+            for (r, t) in poses {
+                faces.push(Face {
+                    surface: surface.clone().transformed(r, &(t * self.to_mm)),
+                    trim: trim.clone(),
+                    origin: format!("#{id} (ADVANCED_FACE) at line {}", inst.line),
+                    flip: !same_sense,
+                    arcs: [None, None],
+                });
+            }
         }
         if faces.is_empty() {
             return Err(Error::Input(format!(

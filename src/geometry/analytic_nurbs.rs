@@ -56,7 +56,11 @@ fn arc_net(
         let end = if k + 1 == n { a1 } else { start + 2.0 * h };
         points.extend([at(start + h, r / h.cos()), at(end, r)]);
         weights.extend([h.cos(), 1.0]);
-        knots.extend(if k + 1 == n { vec![a1; 3] } else { vec![end; 2] });
+        knots.extend(if k + 1 == n {
+            vec![a1; 3]
+        } else {
+            vec![end; 2]
+        });
     }
     (points, weights, knots, h)
 }
@@ -162,10 +166,17 @@ impl NurbsCurve {
     /// Rational Bézier segments over the range, homogeneous `(w x, w y, w z, w)`.
     pub fn segments(&self) -> Vec<Vec<[f64; 4]>> {
         let flat: Vec<f64> = self.points.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
-        curve_segments(self.degree, &self.knots, &flat, &self.weights, 3, self.range)
-            .into_iter()
-            .map(|(h, _)| h.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
-            .collect()
+        curve_segments(
+            self.degree,
+            &self.knots,
+            &flat,
+            &self.weights,
+            3,
+            self.range,
+        )
+        .into_iter()
+        .map(|(h, _)| h.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
+        .collect()
     }
 
     /// `C(t)` by the B-spline basis.
@@ -279,7 +290,10 @@ mod tests {
             let p = arc.point(t0 + s * 2.0 * h) - c;
             let angle = p.dot(&y).atan2(p.dot(&x));
             let law = t0 + h + 2.0 * ((2.0 * s - 1.0) * (0.5 * h).tan()).atan();
-            assert!((angle - law).abs() < 1e-13, "s = {s}: {angle} against {law}");
+            assert!(
+                (angle - law).abs() < 1e-13,
+                "s = {s}: {angle} against {law}"
+            );
         }
     }
 

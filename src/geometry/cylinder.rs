@@ -67,6 +67,14 @@ impl RigidSurface for Cylinder {
         })
     }
 
+    fn analytic_shape(&self) -> Option<AnalyticShape> {
+        Some(AnalyticShape::Cylinder {
+            axis_point: self.axis_point,
+            axis: self.axis_direction,
+            radius: self.radius,
+        })
+    }
+
     fn describe(&self) -> String {
         format!(
             "cylinder r={} axis {} through {}",

@@ -75,4 +75,28 @@ pub trait RigidSurface: std::fmt::Debug {
     fn as_patch_surface(&self) -> Option<&PatchSurface> {
         None
     }
+
+    /// What the surface is if it is analytic (for its display surface).
+    fn analytic_shape(&self) -> Option<AnalyticShape> {
+        None
+    }
+}
+
+/// An analytic surface's defining data (normals and axes unit), for display.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnalyticShape {
+    /// Outward `normal`.
+    Plane {
+        point: Vec3,
+        normal: Vec3,
+    },
+    Cylinder {
+        axis_point: Vec3,
+        axis: Vec3,
+        radius: f64,
+    },
+    Sphere {
+        centre: Vec3,
+        radius: f64,
+    },
 }

@@ -46,6 +46,13 @@ impl RigidSurface for Plane {
         })
     }
 
+    fn analytic_shape(&self) -> Option<AnalyticShape> {
+        Some(AnalyticShape::Plane {
+            point: self.point,
+            normal: self.normal,
+        })
+    }
+
     fn describe(&self) -> String {
         format!(
             "plane through {} with normal {}",

@@ -53,6 +53,13 @@ impl RigidSurface for Sphere {
         })
     }
 
+    fn analytic_shape(&self) -> Option<AnalyticShape> {
+        Some(AnalyticShape::Sphere {
+            centre: self.center,
+            radius: self.radius,
+        })
+    }
+
     fn describe(&self) -> String {
         format!("sphere r={} center {}", self.radius, fmt_vec3(&self.center))
     }

@@ -290,12 +290,14 @@ impl RunOutput {
     }
 
     /// (block name, file) of each part of frame `index`: the blank, then every tool with a
-    /// display surface (patch surfaces), as frames/frame_NNNN.vtu and
+    /// display surface (patch and analytic surfaces), as frames/frame_NNNN.vtu and
     /// frames/frame_NNNN_<tool>.vtu.
     fn frame_files(&self, sim: &Simulation, index: usize) -> Vec<(String, String)> {
         let mut files = vec![("blank".to_string(), format!("frames/frame_{index:04}.vtu"))];
         for c in &sim.model.contacts {
-            if c.tool.surface.as_patch_surface().is_some() {
+            let shown = c.tool.surface.as_patch_surface().is_some()
+                || c.tool.surface.analytic_shape().is_some();
+            if shown {
                 files.push((
                     c.tool.name.clone(),
                     format!("frames/frame_{index:04}_{}.vtu", file_safe(&c.tool.name)),
@@ -321,9 +323,10 @@ impl RunOutput {
             &blank_frame::frame(sim, self.frames.points),
         )?;
         let mut tool_files = files[1..].iter();
+        let region = tool_frame::DisplayRegion::around(&sim.model.mesh.nodes);
         for (c, contact) in sim.model.contacts.iter().enumerate() {
-            if let Some(tool) = tool_frame::tool_frame(&contact.tool, &sim.tool_pose(c)) {
-                let (_, file) = tool_files.next().expect("one file per patch tool");
+            if let Some(tool) = tool_frame::tool_frame(&contact.tool, &sim.tool_pose(c), &region) {
+                let (_, file) = tool_files.next().expect("one file per shown tool");
                 write_vtu(&self.folder.resolve_for_write(file)?, &tool)?;
             }
         }

@@ -19,6 +19,11 @@ BRepBuilderAPI_NurbsConvert (exact: circles and tori become rational quadratic B
 before the `*_nurbs.igs` / `*_nurbs.step` export. `punch_analytic.step` (STEP's PLANE,
 CYLINDRICAL_SURFACE, TOROIDAL_SURFACE, not read) checks that unread surfaces are refused
 with their type and index.
+
+`punch_assembly.step` is an assembly (OCC's XCAF document, STEPCAFControl_Writer) holding
+the NURBS punch as a component placed by a rotation of 30 degrees about z then a
+translation (5, -3, 2.5): CONTEXT_DEPENDENT_SHAPE_REPRESENTATION with an
+ITEM_DEFINED_TRANSFORMATION, which tribo applies.
 """
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
 from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
@@ -103,6 +108,34 @@ def write_step(shape, path):
     assert w.Write(path) == 1
 
 
+def write_assembly(part, path):
+    """`part` as the one component of an assembly, placed (see the module docs)."""
+    import math
+    from OCP.gp import gp_Trsf, gp_Vec, gp_Ax1, gp_Pnt, gp_Dir
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.XCAFApp import XCAFApp_Application
+    from OCP.XCAFDoc import XCAFDoc_DocumentTool
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.STEPCAFControl import STEPCAFControl_Writer
+    rotation = gp_Trsf()
+    rotation.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), math.radians(30))
+    translation = gp_Trsf()
+    translation.SetTranslation(gp_Vec(5.0, -3.0, 2.5))
+    doc = TDocStd_Document(TCollection_ExtendedString("MDTV-XCAF"))
+    XCAFApp_Application.GetApplication_s().InitDocument(doc)
+    shapes = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+    assembly = shapes.NewShape()
+    component = shapes.AddShape(part, False)
+    shapes.AddComponent(assembly, component, TopLoc_Location(translation.Multiplied(rotation)))
+    shapes.UpdateAssemblies()
+    Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
+    Interface_Static.SetCVal_s("write.step.unit", "MM")
+    w = STEPCAFControl_Writer()
+    assert w.Transfer(doc, STEPControl_AsIs)
+    assert w.Write(path) == 1
+
+
 if __name__ == "__main__":
     p, d = punch(), die()
     write_iges(p, "punch_analytic.igs")
@@ -112,3 +145,5 @@ if __name__ == "__main__":
         n = nurbs(shape)
         write_iges(n, f"{name}_nurbs.igs")
         write_step(n, f"{name}_nurbs.step")
+        if name == "punch":
+            write_assembly(n, "punch_assembly.step")
