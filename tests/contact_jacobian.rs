@@ -34,6 +34,19 @@ fn residual(
     (r.status, out)
 }
 
+/// The central-difference stencil of unknown `j` of (x, lambda): `((x, l) + h e_j, (x, l) - h e_j)`.
+fn stencil(x: Vec3, l: Vec3, j: usize, h: f64) -> ((Vec3, Vec3), (Vec3, Vec3)) {
+    let (mut xp, mut xm, mut lp, mut lm) = (x, x, l, l);
+    if j < 3 {
+        xp[j] += h;
+        xm[j] -= h;
+    } else {
+        lp[j - 3] += h;
+        lm[j - 3] -= h;
+    }
+    ((xp, lp), (xm, lm))
+}
+
 /// Worst relative mismatch between the analytic Jacobian and central differences.
 fn fd_mismatch(tool: &Tool, x: Vec3, l: Vec3, xr: Vec3, expect: ContactStatus) -> f64 {
     let p = OperatorParams::fixed_mu(80.0, 0.3, true);
@@ -44,14 +57,7 @@ fn fd_mismatch(tool: &Tool, x: Vec3, l: Vec3, xr: Vec3, expect: ContactStatus) -
     let h = 1e-6;
     let (mut worst, mut scale) = (0.0f64, 1e-12f64);
     for j in 0..6 {
-        let (mut xp, mut xm, mut lp, mut lm) = (x, x, l, l);
-        if j < 3 {
-            xp[j] += h;
-            xm[j] -= h;
-        } else {
-            lp[j - 3] += h;
-            lm[j - 3] -= h;
-        }
+        let ((xp, lp), (xm, lm)) = stencil(x, l, j, h);
         let (sp, rp) = residual(tool, &xp, &lp, &xr, &p);
         let (sm, rm) = residual(tool, &xm, &lm, &xr, &p);
         assert_eq!(
@@ -287,14 +293,7 @@ fn slip_just_outside_the_cone_has_an_exact_but_strongly_curved_jacobian() {
     let mut worst = 0.0f64;
     for j in 0..6 {
         let h = if j < 3 { 1e-7 } else { 1e-4 };
-        let (mut xp, mut xm, mut lp, mut lm) = (x, x, lambda, lambda);
-        if j < 3 {
-            xp[j] += h;
-            xm[j] -= h;
-        } else {
-            lp[j - 3] += h;
-            lm[j - 3] -= h;
-        }
+        let ((xp, lp), (xm, lm)) = stencil(x, lambda, j, h);
         let (a, b) = (eval(&xp, &lp), eval(&xm, &lm));
         assert_eq!(
             (a.status, b.status),
