@@ -34,6 +34,19 @@ fn residual(
     (r.status, out)
 }
 
+/// The central-difference stencil of unknown `j` of (x, lambda): `((x, l) + h e_j, (x, l) - h e_j)`.
+fn stencil(x: Vec3, l: Vec3, j: usize, h: f64) -> ((Vec3, Vec3), (Vec3, Vec3)) {
+    let (mut xp, mut xm, mut lp, mut lm) = (x, x, l, l);
+    if j < 3 {
+        xp[j] += h;
+        xm[j] -= h;
+    } else {
+        lp[j - 3] += h;
+        lm[j - 3] -= h;
+    }
+    ((xp, lp), (xm, lm))
+}
+
 /// Worst relative mismatch between the analytic Jacobian and central differences.
 fn fd_mismatch(tool: &Tool, x: Vec3, l: Vec3, xr: Vec3, expect: ContactStatus) -> f64 {
     let p = OperatorParams::fixed_mu(80.0, 0.3, true);
@@ -44,14 +57,7 @@ fn fd_mismatch(tool: &Tool, x: Vec3, l: Vec3, xr: Vec3, expect: ContactStatus) -
     let h = 1e-6;
     let (mut worst, mut scale) = (0.0f64, 1e-12f64);
     for j in 0..6 {
-        let (mut xp, mut xm, mut lp, mut lm) = (x, x, l, l);
-        if j < 3 {
-            xp[j] += h;
-            xm[j] -= h;
-        } else {
-            lp[j - 3] += h;
-            lm[j - 3] -= h;
-        }
+        let ((xp, lp), (xm, lm)) = stencil(x, l, j, h);
         let (sp, rp) = residual(tool, &xp, &lp, &xr, &p);
         let (sm, rm) = residual(tool, &xm, &lm, &xr, &p);
         assert_eq!(
@@ -251,4 +257,89 @@ fn jacobian_matches_finite_differences_on_patch_tools() {
         let probe_turned = turned.pose(0.5).to_global_point(&local);
         check_statuses_at_foot(&format!("{name} (rotated)"), &turned, probe_turned);
     }
+}
+
+/// The state of the coarse benchmark cup's linear tail (docs/convergence.md, "The linear
+/// tail of the coarse benchmark cup's first increment"): a node slipping on the flat holder
+/// with its tangential trial force only 3 % outside the Coulomb cone (r = 5.75e4 N/mm,
+/// mu = 0.162, sigma_n = -105.5 N, |sigma_t| = 17.6 N against mu |sigma_n| = 17.1 N).
+/// There the Jacobian is exact (central differences), and along a Newton-sized multiplier
+/// step across the slip direction (2.3 N, as measured there) the Taylor remainder is smooth
+/// (it falls fourfold per halving of the step) and as large as the slip direction's own
+/// curvature predicts, `mu |sigma_n| |d lambda_perp|^2 / (2 |sigma_t|^2)`: what slows
+/// Newton there is that curvature, not a wrong or missing term.
+#[test]
+fn slip_just_outside_the_cone_has_an_exact_but_strongly_curved_jacobian() {
+    let plane = Plane::new(Vec3::zeros(), Vec3::new(0.0, 0.0, -1.0)).unwrap();
+    let tool = Tool::new("holder", Arc::new(plane));
+    let pose = tool.pose(0.0);
+    let (r, mu) = (5.75e4, 0.162);
+    let p = OperatorParams::fixed_mu(r, mu, true);
+    let n = Vec3::new(0.0, 0.0, -1.0);
+    let x = Vec3::new(46.875, 56.25, 0.0);
+    // sigma = lambda + r (d n + delta_t) with d = 0: the slip reference sets delta_t.
+    let (sigma_n, sigma_t) = (-105.5, Vec3::new(17.6, 0.0, 0.0));
+    let lambda = Vec3::new(-20.0, 3.0, 0.0) + n * sigma_n;
+    let x_ref = x - (sigma_t - Vec3::new(-20.0, 3.0, 0.0)) / r;
+    let eval = |x: &Vec3, l: &Vec3| {
+        let proj = tool.project(&pose, x, None).unwrap();
+        alart_curnier(x, &x_ref, l, &proj, &p)
+    };
+    let base = eval(&x, &lambda);
+    assert_eq!(base.status, ContactStatus::Slip);
+
+    // Central differences (h = 1e-7 mm in x, 1e-4 N in lambda: each well inside the
+    // 3e-4 mm / 17.6 N scale of the slip direction; the h^2 term is below 1e-6 relative).
+    let mut worst = 0.0f64;
+    for j in 0..6 {
+        let h = if j < 3 { 1e-7 } else { 1e-4 };
+        let ((xp, lp), (xm, lm)) = stencil(x, lambda, j, h);
+        let (a, b) = (eval(&xp, &lp), eval(&xm, &lm));
+        assert_eq!(
+            (a.status, b.status),
+            (ContactStatus::Slip, ContactStatus::Slip)
+        );
+        for i in 0..3 {
+            let fd = (a.f_equi[i] - b.f_equi[i]) / (2.0 * h);
+            let an = if j < 3 {
+                base.equi_x[(i, j)]
+            } else {
+                base.equi_lambda[(i, j - 3)]
+            };
+            let scale = if j < 3 { r } else { 1.0 };
+            worst = worst.max((fd - an).abs() / scale);
+        }
+    }
+    println!("relative mismatch to central differences {worst:.2e}");
+    assert!(
+        worst < 1e-6,
+        "Jacobian differs from finite differences by {worst:.2e}"
+    );
+
+    // Taylor remainder of F_equi along a multiplier step across the slip direction.
+    let step = Vec3::new(0.0, 2.3, 0.0);
+    let remainder = |s: f64| {
+        let moved = eval(&x, &(lambda + step * s));
+        (moved.f_equi - base.f_equi - base.equi_lambda * step * s).norm()
+    };
+    let (r1, r2, r4) = (remainder(1.0), remainder(0.5), remainder(0.25));
+    let predicted = mu * sigma_n.abs() * step.norm().powi(2) / (2.0 * sigma_t.norm().powi(2));
+    println!("remainders {r1:.3e} {r2:.3e} {r4:.3e}, predicted {predicted:.3e}");
+    // Smooth: the second-order term dominates (ratio 4 up to the third-order term, which
+    // is |d lambda| / |sigma_t| = 13 % of it at the full step).
+    for (big, small) in [(r1, r2), (r2, r4)] {
+        assert!((3.5..4.5).contains(&(big / small)), "ratio {}", big / small);
+    }
+    // As large as the slip direction's curvature says (within its own third-order term).
+    assert!(
+        (0.8..1.2).contains(&(r1 / predicted)),
+        "remainder {r1:.3e} against {predicted:.3e}"
+    );
+    // And large: a thousandth of the step's own force change would be quadratic Newton
+    // with room to spare; here it is several percent.
+    let linear = (base.equi_lambda * step).norm();
+    assert!(
+        r1 > 0.03 * linear,
+        "remainder {r1:.3e}, linear part {linear:.3e}"
+    );
 }

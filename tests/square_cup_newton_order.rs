@@ -29,8 +29,11 @@
 //! are >= 1.79 (increment 6: 5.3e-3, 4.3e-5, 7.7e-9, a quadratic constant r+/r^2 growing
 //! from 1.5 to 4.2 inside the window), the benchmark variant's >= 1.94 but for increment 1,
 //! 1.10 (3.9e-4 ... 5.0e-5, 1.3e-7, 1.8e-10: full steps, no status or yield change, Newton
-//! corrections 3.1e-5, 4.5e-6, 2.9e-6, 2.0e-7, 5.6e-9: a linear tail whose cause is not
-//! found; docs/convergence.md). So the test holds what is true today and fails if Newton
+//! corrections 3.1e-5, 4.5e-6, 2.9e-6, 2.0e-7, 5.6e-9: not a Jacobian defect, the
+//! Jacobian there matches central differences block by block and the Taylor remainder along
+//! each step is quadratic, but Newton's pre-asymptotic phase in the multiplier of a node
+//! pair slipping 3 % outside the Coulomb cone, whose slip direction turns 0.1 rad per step;
+//! docs/convergence.md). So the test holds what is true today and fails if Newton
 //! turns into a fixed-point iteration broadly: a median >= 1.9 and at least 80 % of the
 //! measured increments >= 1.8 over both variants, with at least 5 measured per variant.
 
