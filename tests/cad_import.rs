@@ -439,3 +439,50 @@ fn a_part_placed_in_a_step_assembly_imports_at_its_pose() {
     );
     assert!((a.foot - b.foot).norm() > 1.0, "{a:?} {b:?}");
 }
+
+/// A 190 plane surface (location 116 `(0, 0, 5)`, normal 123 `(0, 0, 2)`) trimmed by a
+/// square of model-space 110 lines (`|x|, |y| <= 10`): read as a 108 plane is, the exact
+/// plane `z = 5` inside the square (foot, normal and gap to round-off), no foot outside.
+#[test]
+fn a_190_plane_surface_trimmed_by_a_square_is_the_exact_plane() {
+    let plane = iges_tool("plane_surface_190.igs", &ImportOptions::default());
+    let mut rng = Rng(190);
+    let (mut inside, mut outside) = (0, 0);
+    for _ in 0..2000 {
+        let x = Vec3::new(
+            rng.uniform(-15.0, 15.0),
+            rng.uniform(-15.0, 15.0),
+            rng.uniform(-3.0, 12.0),
+        );
+        let within = x.x.abs() < 10.0 - 1e-9 && x.y.abs() < 10.0 - 1e-9;
+        match plane.project(&x, None) {
+            Some(p) if within => {
+                inside += 1;
+                assert!(
+                    (p.foot - Vec3::new(x.x, x.y, 5.0)).norm() < 1e-12,
+                    "{x:?} {p:?}"
+                );
+                assert!((p.normal - Vec3::z()).norm() < 1e-12, "{x:?} {p:?}");
+                assert!((p.gap - (x.z - 5.0)).abs() < 1e-12, "{x:?} {p:?}");
+            }
+            // Outside the square: no foot, or one on its rim (the closest trimmed point).
+            Some(p) => {
+                let rim = p.foot.x.abs().max(p.foot.y.abs());
+                assert!(
+                    (rim - 10.0).abs() < 1e-9,
+                    "x = {x:?}: foot {:?} off the rim",
+                    p.foot
+                );
+                outside += 1;
+            }
+            None => {
+                assert!(!within, "x = {x:?}: no foot inside the square");
+                outside += 1;
+            }
+        }
+    }
+    assert!(
+        inside > 500 && outside > 500,
+        "{inside} inside, {outside} outside"
+    );
+}

@@ -11,10 +11,10 @@
 //! - 124 transformation matrix on a surface or face (applied exactly to control points).
 //!
 //! - analytic surfaces a CAD exporter writes (in [`super::iges_analytic`]): 108 plane
-//!   (trimmed by its model-space curves) and 120 surface of revolution, made exact NURBS.
+//!   and 190 plane surface (trimmed by its model-space curves) and 120 surface of revolution, made exact NURBS.
 //!
 //! Faces are the 144 entities, and the 128, 120 and bounded 108 entities no 144 or 142
-//! refers to, in directory order. Other surfaces (114, 118, 122, 140, 143, 190-198) are
+//! refers to, in directory order. Other surfaces (114, 118, 122, 140, 143, 192-198) are
 //! refused naming the entity: export B-splines instead (OpenCascade:
 //! `BRepBuilderAPI_NurbsConvert`). Other entities (annotations, groups, model-space
 //! curves) are ignored. Every error names the file and the line (`file:line`),
@@ -93,7 +93,7 @@ fn name(kind: i64) -> &'static str {
 }
 
 /// Surfaces a CAD exporter may write that are not read (a face on one is refused).
-const UNREAD_SURFACES: [i64; 11] = [114, 118, 122, 140, 143, 186, 190, 192, 194, 196, 198];
+const UNREAD_SURFACES: [i64; 10] = [114, 118, 122, 140, 143, 186, 192, 194, 196, 198];
 
 /// Millimetres per unit of the global section's unit flag (IGES 5.3, parameter 14).
 fn unit_to_mm(flag: i64, unit_name: &str) -> Option<f64> {
@@ -515,7 +515,7 @@ impl<'a> Iges<'a> {
                         arcs,
                     });
                 }
-                108 if !used.contains(&pointer) => faces.push(self.bounded_plane(e)?),
+                108 | 190 if !used.contains(&pointer) => faces.push(self.bounded_plane(e)?),
                 k if UNREAD_SURFACES.contains(&k) && !used.contains(&pointer) => {
                     return Err(self.unread_surface(e))
                 }
@@ -610,7 +610,7 @@ impl<'a> Iges<'a> {
         let (surface, arcs) = match s.kind {
             128 => (self.surface(s)?, [None, None]),
             120 => self.revolution(s)?,
-            108 => return self.trimmed_plane(e, &p, s),
+            108 | 190 => return self.trimmed_plane(e, &p, s),
             k if UNREAD_SURFACES.contains(&k) => return Err(self.unread_surface(s)),
             _ => {
                 return Err(p.fail(format!(

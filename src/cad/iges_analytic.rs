@@ -14,6 +14,9 @@
 //!   frame's coordinates (so the projected loops are its trim), its normal `e1 x e2` being
 //!   the plane's `(A, B, C)`: the outward one in OpenCascade's files.
 //!
+//! - 190 plane surface: the same plane given by a 116 location point and a 123 normal
+//!   direction (its reference direction, form 1, is not needed), read as a 108.
+//!
 //! A curve off its plane by more than `1e-6` of the face's size is refused (the file and
 //! the curve entity named).
 
@@ -135,15 +138,20 @@ impl Iges<'_> {
         Ok(out)
     }
 
-    /// A 108 plane's point and unit normal in mm (after its 124 matrix).
+    /// A 108 plane's, or a 190 plane surface's, point and unit normal in mm (after its 124
+    /// matrix).
     fn plane(&self, s: &Entry) -> Result<(Vec3, Vec3)> {
         let p = self.params(s)?;
-        let v = p.reals(1, 4, "plane coefficient A, B, C, D")?;
-        let n = Vec3::new(v[0], v[1], v[2]);
+        let (point, n) = if s.kind == 190 {
+            self.point_and_normal(&p)?
+        } else {
+            let v = p.reals(1, 4, "plane coefficient A, B, C, D")?;
+            let n = Vec3::new(v[0], v[1], v[2]);
+            (n * (v[3] / n.norm_squared()), n)
+        };
         if !(n.norm() > 0.0) {
-            return Err(p.fail("its normal (A, B, C) is zero".to_string()));
+            return Err(p.fail("its normal is zero".to_string()));
         }
-        let point = n * (v[3] / n.norm_squared());
         let (r, t) = self.matrix(s, 0)?;
         let normal = r
             .try_inverse()
@@ -151,6 +159,27 @@ impl Iges<'_> {
             .and_then(|n| n.try_normalize(0.0))
             .ok_or_else(|| p.fail("its transformation matrix is singular".to_string()))?;
         Ok(((r * point + t) * self.to_mm, normal))
+    }
+
+    /// A 190 plane surface's location (a 116 point, after its matrix) and normal (a 123
+    /// direction, after its matrix's rotation), in the 190's space, not scaled to mm.
+    fn point_and_normal(&self, p: &Params) -> Result<(Vec3, Vec3)> {
+        let at = |i: usize, kind: i64, what: &str| -> Result<(Vec3, Mat3, Vec3)> {
+            let e = self.entry(p.int(i, what)?, p, what)?;
+            let q = self.params(e)?;
+            if e.kind != kind {
+                return Err(p.fail(format!(
+                    "its {what} names {}, not a {kind}",
+                    Self::describe(e)
+                )));
+            }
+            let v = q.reals(1, 3, "coordinate")?;
+            let (r, t) = self.matrix(e, 0)?;
+            Ok((Vec3::new(v[0], v[1], v[2]), r, t))
+        };
+        let (x, r, t) = at(1, 116, "location pointer")?;
+        let (n, rn, _) = at(2, 123, "normal pointer")?;
+        Ok((r * x + t, rn * n))
     }
 
     /// The model-space curve of the 142 at `pointer` (named from `face`).
@@ -188,13 +217,20 @@ impl Iges<'_> {
         Ok(face)
     }
 
-    /// A 108 plane not used by a 144: a face if it has a bounding curve (form 1).
+    /// A 108 plane not used by a 144: a face if it has a bounding curve (form 1); a 190
+    /// plane surface has none.
     pub(super) fn bounded_plane(&self, s: &Entry) -> Result<Face> {
         let p = self.params(s)?;
-        let curve = p.int(5, "PTR, bounding curve pointer")?;
+        let curve = if s.kind == 190 {
+            0
+        } else {
+            p.int(5, "PTR, bounding curve pointer")?
+        };
         if curve == 0 {
             return Err(p.fail(
-                "an unbounded plane is not a face: bound it (form 1) or trim it (144)".to_string(),
+                "an unbounded plane is not a face: trim it (144), or write a 108 bounded by a \
+                 curve (form 1)"
+                    .to_string(),
             ));
         }
         let bound = self.model_segments(self.entry(curve, &p, "bounding curve")?, 0)?;
