@@ -495,28 +495,15 @@ impl<'a> Iges<'a> {
             let pointer = (2 * i + 1) as i64;
             match e.kind {
                 144 => faces.push(self.trimmed_face(e)?),
-                128 if !used.contains(&pointer) => {
-                    let surface = self.surface(e)?;
-                    faces.push(Face {
-                        surface,
-                        trim: None,
-                        origin: Self::describe(e),
-                        flip: false,
-                        arcs: [None, None],
-                    });
-                }
-                120 if !used.contains(&pointer) => {
-                    let (surface, arcs) = self.revolution(e)?;
-                    faces.push(Face {
-                        surface,
-                        trim: None,
-                        origin: Self::describe(e),
-                        flip: false,
-                        arcs,
-                    });
-                }
-                122 if !used.contains(&pointer) => {
-                    let (surface, arcs, _) = self.tabulated_cylinder(e)?;
+                128 | 120 | 122 if !used.contains(&pointer) => {
+                    let (surface, arcs) = match e.kind {
+                        128 => (self.surface(e)?, [None, None]),
+                        120 => self.revolution(e)?,
+                        _ => {
+                            let (surface, arcs, _) = self.tabulated_cylinder(e)?;
+                            (surface, arcs)
+                        }
+                    };
                     faces.push(Face {
                         surface,
                         trim: None,
