@@ -486,3 +486,85 @@ fn a_190_plane_surface_trimmed_by_a_square_is_the_exact_plane() {
         "{inside} inside, {outside} outside"
     );
 }
+
+/// 122 tabulated cylinders (generatrix `(0, 0, 20)`) trimmed in IGES's normalised `(u, v)`
+/// by `[0.25, 0.75]^2`: from a 110 line `x = -10 + 20 u` (the plane `y = 0`, trim
+/// `|x| <= 5`) and from a 100 half circle of radius 10 (angle `pi u`, trim `pi/4..3pi/4`),
+/// both `z` in `[5, 15]`. Inside the trim the foot is the exact surface's (foot, normal and
+/// gap to 1e-12); every foot lies on the exact surface inside the trim.
+#[test]
+fn a_122_tabulated_cylinder_is_the_exact_extrusion_trimmed_in_normalised_parameters() {
+    use std::f64::consts::PI;
+    for name in ["line", "arc"] {
+        let tool = iges_tool(
+            &format!("tabulated_cylinder_122_{name}.igs"),
+            &ImportOptions::default(),
+        );
+        // (exact foot, whether it lies inside the trim) of a point.
+        let exact = |x: &Vec3| -> (Vec3, bool) {
+            let z_in = (5.0..=15.0).contains(&x.z);
+            if name == "line" {
+                (Vec3::new(x.x, 0.0, x.z), z_in && x.x.abs() <= 5.0)
+            } else {
+                let r = x.x.hypot(x.y);
+                let a = x.y.atan2(x.x);
+                (
+                    Vec3::new(10.0 * x.x / r, 10.0 * x.y / r, x.z),
+                    z_in && (PI / 4.0..=3.0 * PI / 4.0).contains(&a),
+                )
+            }
+        };
+        let mut rng = Rng(122);
+        let (mut inside, mut feet) = (0, 0);
+        for _ in 0..2000 {
+            let x = if name == "line" {
+                Vec3::new(
+                    rng.uniform(-9.0, 9.0),
+                    rng.uniform(-3.0, 3.0),
+                    rng.uniform(0.0, 20.0),
+                )
+            } else {
+                let (r, a) = (rng.uniform(6.0, 14.0), rng.uniform(0.0, PI));
+                Vec3::new(r * a.cos(), r * a.sin(), rng.uniform(0.0, 20.0))
+            };
+            let (foot, within) = exact(&x);
+            let margin = exact(&(x + Vec3::new(1e-7, 1e-7, 1e-7))).1
+                == exact(&(x - Vec3::new(1e-7, 1e-7, 1e-7))).1;
+            match tool.project(&x, None) {
+                Some(p) => {
+                    feet += 1;
+                    let (on, in_trim) = exact(&p.foot);
+                    assert!(
+                        (on - p.foot).norm() < 1e-12,
+                        "{name}: foot {:?} off",
+                        p.foot
+                    );
+                    let rim =
+                        exact(&(p.foot * (1.0 + 1e-9))).1 || exact(&(p.foot * (1.0 - 1e-9))).1;
+                    assert!(
+                        in_trim || rim,
+                        "{name}: x = {x:?}: foot {:?} outside the trim",
+                        p.foot
+                    );
+                    assert!(
+                        (p.normal.norm() - 1.0).abs() < 1e-12
+                            && (x - p.foot - p.normal * p.gap).norm() < 1e-12,
+                        "{name}: x = {x:?}: {p:?}"
+                    );
+                    if within && margin {
+                        inside += 1;
+                        assert!((p.foot - foot).norm() < 1e-12, "{name}: x = {x:?}: {p:?}");
+                    }
+                }
+                None => assert!(
+                    !(within && margin),
+                    "{name}: x = {x:?}: no foot in the trim"
+                ),
+            }
+        }
+        assert!(
+            inside > 200 && feet >= inside,
+            "{name}: {inside} inside, {feet} feet"
+        );
+    }
+}

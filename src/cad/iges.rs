@@ -11,10 +11,10 @@
 //! - 124 transformation matrix on a surface or face (applied exactly to control points).
 //!
 //! - analytic surfaces a CAD exporter writes (in [`super::iges_analytic`]): 108 plane
-//!   and 190 plane surface (trimmed by its model-space curves) and 120 surface of revolution, made exact NURBS.
+//!   and 190 plane surface (trimmed by its model-space curves) 120 surface of revolution and 122 tabulated cylinder, made exact NURBS.
 //!
-//! Faces are the 144 entities, and the 128, 120 and bounded 108 entities no 144 or 142
-//! refers to, in directory order. Other surfaces (114, 118, 122, 140, 143, 192-198) are
+//! Faces are the 144 entities, and the 128, 120, 122 and bounded 108 entities no 144 or 142
+//! refers to, in directory order. Other surfaces (114, 118, 140, 143, 192-198) are
 //! refused naming the entity: export B-splines instead (OpenCascade:
 //! `BRepBuilderAPI_NurbsConvert`). Other entities (annotations, groups, model-space
 //! curves) are ignored. Every error names the file and the line (`file:line`),
@@ -93,7 +93,7 @@ fn name(kind: i64) -> &'static str {
 }
 
 /// Surfaces a CAD exporter may write that are not read (a face on one is refused).
-const UNREAD_SURFACES: [i64; 10] = [114, 118, 122, 140, 143, 186, 192, 194, 196, 198];
+const UNREAD_SURFACES: [i64; 9] = [114, 118, 140, 143, 186, 192, 194, 196, 198];
 
 /// Millimetres per unit of the global section's unit flag (IGES 5.3, parameter 14).
 fn unit_to_mm(flag: i64, unit_name: &str) -> Option<f64> {
@@ -495,18 +495,15 @@ impl<'a> Iges<'a> {
             let pointer = (2 * i + 1) as i64;
             match e.kind {
                 144 => faces.push(self.trimmed_face(e)?),
-                128 if !used.contains(&pointer) => {
-                    let surface = self.surface(e)?;
-                    faces.push(Face {
-                        surface,
-                        trim: None,
-                        origin: Self::describe(e),
-                        flip: false,
-                        arcs: [None, None],
-                    });
-                }
-                120 if !used.contains(&pointer) => {
-                    let (surface, arcs) = self.revolution(e)?;
+                128 | 120 | 122 if !used.contains(&pointer) => {
+                    let (surface, arcs) = match e.kind {
+                        128 => (self.surface(e)?, [None, None]),
+                        120 => self.revolution(e)?,
+                        _ => {
+                            let (surface, arcs, _) = self.tabulated_cylinder(e)?;
+                            (surface, arcs)
+                        }
+                    };
                     faces.push(Face {
                         surface,
                         trim: None,
@@ -524,7 +521,7 @@ impl<'a> Iges<'a> {
         }
         if faces.is_empty() {
             return Err(Error::Input(format!(
-                "{}: no face (entity 128, 144, 120 or bounded 108) in the file",
+                "{}: no face (entity 128, 144, 120, 122 or bounded 108) in the file",
                 self.source
             )));
         }
@@ -607,9 +604,16 @@ impl<'a> Iges<'a> {
     fn trimmed_face(&self, e: &Entry) -> Result<Face> {
         let p = self.params(e)?;
         let s = self.entry(p.int(1, "PTS, surface pointer")?, &p, "surface")?;
+        // IGES's `u` of a 122 is normalised; its surface runs by the directrix's own.
+        let mut u_map = None;
         let (surface, arcs) = match s.kind {
             128 => (self.surface(s)?, [None, None]),
             120 => self.revolution(s)?,
+            122 => {
+                let (surface, arcs, map) = self.tabulated_cylinder(s)?;
+                u_map = Some(map);
+                (surface, arcs)
+            }
             108 | 190 => return self.trimmed_plane(e, &p, s),
             k if UNREAD_SURFACES.contains(&k) => return Err(self.unread_surface(s)),
             _ => {
@@ -635,6 +639,12 @@ impl<'a> Iges<'a> {
         }
         for k in 0..holes {
             loops.push(self.boundary(p.int(5 + k, "PTI, inner boundary pointer")?, &p)?);
+        }
+        if let Some([a, b]) = u_map {
+            let from_file = usize::from(outer != 0);
+            for segment in loops.iter_mut().skip(1 - from_file).flatten() {
+                *segment = segment.u_mapped(a, b);
+            }
         }
         let trim = TrimRegion::new(loops).map_err(|e| p.fail(super::strip(e)))?;
         let (r, t) = self.matrix(e, 0)?;

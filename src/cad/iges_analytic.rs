@@ -17,12 +17,15 @@
 //! - 190 plane surface: the same plane given by a 116 location point and a 123 normal
 //!   direction (its reference direction, form 1, is not needed), read as a 108.
 //!
+//! - 122 tabulated cylinder: the exact extrusion of its directrix in the directrix's own
+//!   parameter (see [`Iges::tabulated_cylinder`]); its trims' normalised `u` is mapped.
+//!
 //! A curve off its plane by more than `1e-6` of the face's size is refused (the file and
 //! the curve entity named).
 
 use super::iges::{bspline_curve, BsplineCurve, Entry, Iges, Params};
 use super::Face;
-use crate::geometry::analytic_nurbs::{revolution, NurbsCurve};
+use crate::geometry::analytic_nurbs::{extrusion, revolution, NurbsCurve};
 use crate::geometry::nurbs::NurbsSurface;
 use crate::geometry::trim::{TrimRegion, TrimSegment};
 use crate::geometry::{Mat3, Vec3};
@@ -61,6 +64,27 @@ impl Iges<'_> {
         let (r, t) = self.matrix(e, 0)?;
         let surface = surface.transformed(&(r * self.to_mm), &(t * self.to_mm));
         Ok((surface, [generatrix.arc_half_angle, Some(half)]))
+    }
+
+    /// A 122 tabulated cylinder in mm (after its 124 matrix): IGES's `S(u, v) = C(t) +
+    /// v (L - C(T0))`, `t = T0 + u (T1 - T0)`, made the exact extrusion of the directrix
+    /// in the directrix's own parameter `t` (the angle on a 100 arc, whose half angle is
+    /// returned). Returns the surface, the arc half angles, and `[T0, T1 - T0]`: a trim
+    /// given in IGES's `u` maps to `t` by `u -> T0 + (T1 - T0) u`.
+    pub(super) fn tabulated_cylinder(
+        &self,
+        e: &Entry,
+    ) -> Result<(NurbsSurface, [Option<f64>; 2], [f64; 2])> {
+        let p = self.params(e)?;
+        let directrix =
+            self.model_curve(self.entry(p.int(1, "DE, directrix pointer")?, &p, "directrix")?)?;
+        let l = p.reals(2, 3, "LX, LY, LZ, generatrix end point")?;
+        let [t0, t1] = directrix.range;
+        let direction = Vec3::new(l[0], l[1], l[2]) - directrix.point(t0);
+        let surface = extrusion(&directrix, direction).map_err(|err| p.fail(super::strip(err)))?;
+        let (r, t) = self.matrix(e, 0)?;
+        let surface = surface.transformed(&(r * self.to_mm), &(t * self.to_mm));
+        Ok((surface, [directrix.arc_half_angle, None], [t0, t1 - t0]))
     }
 
     /// A curve entity in its parent's space (its own 124 matrix applied), not scaled to mm:

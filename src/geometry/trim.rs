@@ -41,6 +41,17 @@ impl TrimSegment {
         [h[0] / h[2], h[1] / h[2]]
     }
 
+    /// The segment with `u` mapped to `a + b u` (exact: the map is affine, so it acts on
+    /// the homogeneous points as `w u -> a w + b w u`).
+    pub fn u_mapped(&self, a: f64, b: f64) -> TrimSegment {
+        let points = self
+            .points
+            .iter()
+            .map(|h| [a * h[2] + b * h[0], h[1], h[2]])
+            .collect();
+        TrimSegment { points }
+    }
+
     /// The same segment run backwards.
     pub fn reversed(&self) -> TrimSegment {
         TrimSegment::new(self.points.iter().rev().copied().collect())

@@ -1,6 +1,10 @@
 """Writes the small hand-made IGES fixtures of tests/cad_import.rs (no CAD library):
 plane_surface_190.igs, a 190 plane surface (116 point, 123 normal) trimmed by a square
-loop of 110 lines (a 102 as the 142's model-space curve) in a 144.
+loop of 110 lines (a 102 as the 142's model-space curve) in a 144;
+tabulated_cylinder_122_{line,arc}.igs, a 122 of a 110 line (-10,0,0)-(10,0,0) or a 100
+half circle (radius 10 about the z axis, angles 0 to pi), generatrix end L = (.., .., 20)
+(so the generatrix is (0, 0, 20)), trimmed in IGES's normalised (u, v) by the square
+[0.25, 0.75]^2 (a 102 of 110 lines as the 142's parameter-space curve) in a 144.
 Run: python3 make_small_iges.py (in this folder)."""
 
 
@@ -40,3 +44,18 @@ ents.append((102, 0, [4] + [de(3 + i) for i in range(4)]))  # 7
 ents.append((142, 0, [0, de(2), 0, de(7), 1]))  # 8
 ents.append((144, 0, [de(2), 1, 0, de(8)]))  # 9
 open("plane_surface_190.igs", "w").write(iges(ents))
+
+
+for name, directrix in [
+    ("line", (110, 0, [-10.0, 0.0, 0.0, 10.0, 0.0, 0.0])),
+    ("arc", (100, 0, [0.0, 0.0, 0.0, 10.0, 0.0, -10.0, 0.0])),
+]:
+    ents = [directrix, (122, 0, [de(0), 10.0, 0.0, 20.0] if name == "arc" else [de(0), -10.0, 0.0, 20.0])]
+    square = [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]
+    for i in range(4):
+        a, b = square[i], square[(i + 1) % 4]
+        ents.append((110, 0, [a[0], a[1], 0.0, b[0], b[1], 0.0]))  # 2..5
+    ents.append((102, 0, [4] + [de(2 + i) for i in range(4)]))  # 6
+    ents.append((142, 0, [1, de(1), de(6), 0, 1]))  # 7
+    ents.append((144, 0, [de(1), 1, 0, de(7)]))  # 8
+    open(f"tabulated_cylinder_122_{name}.igs", "w").write(iges(ents))
