@@ -27,6 +27,22 @@ fn run(tag: &str, extra: &[&str]) -> Value {
     serde_json::from_str(&text).expect("summary.json is JSON")
 }
 
+/// Asserts that two cup summaries have the same punch force peak and final draw-ins
+/// (`dx`, `dy`, `dd`) to `rel` relative; the draw-ins of `a` must exceed `min_draw_in`
+/// and its peak 1000 N, so that a run that did not draw cannot pass.
+fn assert_same_cup(a: &Value, b: &Value, rel: f64, min_draw_in: f64) {
+    let peak = |s: &Value| s["punch_force_peak_n"].as_f64().unwrap();
+    let (pa, pb) = (peak(a), peak(b));
+    assert!(pa > 1000.0, "{pa}");
+    assert!((pa - pb).abs() <= rel * pa, "punch force peak {pa} vs {pb}");
+    for key in ["dx", "dy", "dd"] {
+        let d = |s: &Value| s["final_draw_in"][key].as_f64().unwrap();
+        let (da, db) = (d(a), d(b));
+        assert!(da > min_draw_in, "{key}: {da}");
+        assert!((da - db).abs() <= rel * da, "draw-in {key}: {da} vs {db}");
+    }
+}
+
 #[test]
 fn cad_tools_give_the_built_in_draw_in_and_punch_force() {
     let builtin = run("builtin", &["--set", "cells=8"]);
@@ -44,16 +60,7 @@ fn cad_tools_give_the_built_in_draw_in_and_punch_force() {
     for s in [&builtin, &cad] {
         assert_eq!(s["status"], "finished", "{s}");
     }
-    let peak = |s: &Value| s["punch_force_peak_n"].as_f64().unwrap();
-    let (a, b) = (peak(&builtin), peak(&cad));
-    assert!(a > 1000.0, "{a}");
-    assert!((a - b).abs() <= 1e-6 * a, "punch force peak {a} vs {b}");
-    for key in ["dx", "dy", "dd"] {
-        let d = |s: &Value| s["final_draw_in"][key].as_f64().unwrap();
-        let (a, b) = (d(&builtin), d(&cad));
-        assert!(a > 0.0, "{key}: {a}");
-        assert!((a - b).abs() <= 1e-6 * a, "draw-in {key}: {a} vs {b}");
-    }
+    assert_same_cup(&builtin, &cad, 1e-6, 0.0);
 }
 
 /// The cup on the Gmsh quarter blank (tests/data/mesh/quarter_blank.msh: 75 x 75 x 0.81,
@@ -87,16 +94,7 @@ fn gmsh_blank_gives_the_block_draw_in_and_punch_force() {
         assert_eq!(block[key], gmsh[key], "{key}");
     }
     assert_eq!(block["nodes"], 2 * 11 * 11);
-    let peak = |s: &Value| s["punch_force_peak_n"].as_f64().unwrap();
-    let (a, b) = (peak(&block), peak(&gmsh));
-    assert!(a > 1000.0, "{a}");
-    assert!((a - b).abs() <= 1e-9 * a, "punch force peak {a} vs {b}");
-    for key in ["dx", "dy", "dd"] {
-        let d = |s: &Value| s["final_draw_in"][key].as_f64().unwrap();
-        let (a, b) = (d(&block), d(&gmsh));
-        assert!(a > 0.1, "{key}: {a}");
-        assert!((a - b).abs() <= 1e-9 * a, "draw-in {key}: {a} vs {b}");
-    }
+    assert_same_cup(&block, &gmsh, 1e-9, 0.1);
 }
 
 /// The cup built wholly from imported geometry: the STEP punch and die of
@@ -125,14 +123,5 @@ fn step_tools_on_the_gmsh_blank_give_the_built_in_cup() {
         assert_eq!(s["status"], "finished", "{s}");
     }
     assert_eq!(builtin["nodes"], imported["nodes"]);
-    let peak = |s: &Value| s["punch_force_peak_n"].as_f64().unwrap();
-    let (a, b) = (peak(&builtin), peak(&imported));
-    assert!(a > 1000.0, "{a}");
-    assert!((a - b).abs() <= 1e-6 * a, "punch force peak {a} vs {b}");
-    for key in ["dx", "dy", "dd"] {
-        let d = |s: &Value| s["final_draw_in"][key].as_f64().unwrap();
-        let (a, b) = (d(&builtin), d(&imported));
-        assert!(a > 0.1, "{key}: {a}");
-        assert!((a - b).abs() <= 1e-6 * a, "draw-in {key}: {a} vs {b}");
-    }
+    assert_same_cup(&builtin, &imported, 1e-6, 0.1);
 }
