@@ -347,6 +347,7 @@ impl IncrementContext<'_> {
         let threads = element_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);
         let mut trial_points = self.committed_points.to_vec();
+        self.warm_start.seed(&mut trial_points);
         let elements = evaluate_elements(
             model,
             x,
@@ -358,6 +359,15 @@ impl IncrementContext<'_> {
         let mut jac = SparseMatrix::zeros(self.pattern.clone());
         slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
         times.elements += t0.elapsed().as_secs_f64();
+        // The follower loads' stiffness, in `evaluate_with`'s order (their forces are
+        // already in `eval`'s residual; the scratch copy is discarded).
+        if !model.follower_loads.is_empty() {
+            let mut scratch = vec![0.0; 3 * self.dofs.n_nodes];
+            for load in &model.follower_loads {
+                let mut add = |r: usize, c: usize, v: f64| jac.add(r, c, -v);
+                load.add_forces(&model.mesh, x, self.time, &mut scratch, Some(&mut add));
+            }
+        }
         let t1 = Instant::now();
         let mut unit = self.is_fixed.to_vec();
         for (c, contact) in model.contacts.iter().enumerate() {
@@ -740,8 +750,14 @@ mod tests {
     /// former's, bit for bit.
     #[test]
     fn residual_only_evaluation_equals_the_full_one_but_the_jacobian() {
-        for force_controlled in [false, true] {
-            let (model, x) = pressed_strip(force_controlled);
+        for (force_controlled, end_moment) in [(false, false), (true, false), (false, true)] {
+            let (mut model, x) = pressed_strip(force_controlled);
+            if end_moment {
+                // A follower load: its stiffness must be in the completed Jacobian too.
+                model
+                    .add_end_moment("x+", 40.0, Vec3::z(), ScalarSchedule::constant(1.0))
+                    .unwrap();
+            }
             let dofs = DofMap::new(&model);
             let pattern = Arc::new(dofs.pattern(&model));
             let mut is_fixed = vec![false; dofs.n_dofs];
