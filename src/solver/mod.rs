@@ -8,6 +8,7 @@ pub mod cycling;
 pub mod energy;
 pub mod follower_load;
 pub mod force_control;
+pub mod kinematics_check;
 pub mod line_search;
 pub mod linear;
 pub mod model;

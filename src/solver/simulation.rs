@@ -485,6 +485,16 @@ impl Simulation {
             self.saved.push_back(state);
         }
         self.phase_times.add(&trial.times);
+        let kinematics_warning = (self.model.settings.kinematics
+            == crate::element::StrainTheory::Small)
+            .then(|| {
+                super::kinematics_check::small_strain_warning(
+                    &self.points,
+                    &trial.eval.trial_points,
+                    self.points.len() / self.model.mesh.hexes.len().max(1),
+                )
+            })
+            .flatten();
         let mut report = self.commit(
             t_new,
             trial.x,
@@ -493,6 +503,7 @@ impl Simulation {
             trial.residuals,
         );
         report.line_search_cuts = trial.line_search_cuts;
+        report.warnings.extend(kinematics_warning);
         // Cycling is worth one explanation per run, not one line per increment: the nodes
         // of every increment are in its report and in history.csv (cycling_nodes).
         if !trial.cycling.is_empty() && !self.cycling_explained {
