@@ -1415,4 +1415,31 @@ mod tests {
             assert!(!e.contains("unknown setting"), "{key}: {e}");
         }
     }
+
+    /// The other direction: every key `apply_settings` matches is listed, so the error
+    /// message and the REPL's completion offer it. Read from this file's source: the
+    /// match arms at the indentation of the first key (rustfmt keeps it; nested matches
+    /// over a key's values are indented deeper).
+    #[test]
+    fn every_read_setting_key_is_listed() {
+        let source = include_str!("api_sim.rs");
+        let start = source.find("fn apply_settings(").unwrap();
+        let end = start + source[start..].find("other =>").unwrap();
+        let body = &source[start..end];
+        let first = body.find("\"step_control\" =>").unwrap();
+        let indent = first - body[..first].rfind('\n').unwrap() - 1;
+        let arms: Vec<&str> = body
+            .lines()
+            .filter(|l| l.len() > indent && l[..indent].trim().is_empty())
+            .filter_map(|l| l[indent..].strip_prefix('"'))
+            .filter_map(|l| l.split_once("\" =>").map(|(key, _)| key))
+            .collect();
+        assert!(arms.len() >= 30, "{arms:?}");
+        for key in arms {
+            assert!(
+                SETTING_KEYS.contains(&key),
+                "'{key}' is read but not in SETTING_KEYS"
+            );
+        }
+    }
 }
