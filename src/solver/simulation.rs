@@ -101,6 +101,9 @@ pub struct Simulation {
     pub(super) interrupt: crate::interrupt::Interrupt,
     /// Whether the run has explained contact-status cycling to the user (once per run).
     pub(super) cycling_explained: bool,
+    /// Whether the run has explained a step limit exceeded at the minimum step (in full
+    /// once per run; later increments get one short line each).
+    pub(super) limit_explained: bool,
 }
 
 impl Simulation {
@@ -188,6 +191,7 @@ impl Simulation {
             last_step: None,
             interrupt: crate::interrupt::Interrupt::new(),
             cycling_explained: false,
+            limit_explained: false,
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -423,9 +427,11 @@ impl Simulation {
                     report.limit = verdict.limit;
                     let (ratio, which) = measures.ratio(&step);
                     if ratio < 1.0 {
-                        report.warnings.push(format!(
-                            "{which:?} increment exceeds its limit by a factor {:.3} at the minimum step",
-                            1.0 / ratio
+                        report.warnings.push(super::step_control::limit_warning(
+                            which,
+                            1.0 / ratio,
+                            dt_min,
+                            !std::mem::replace(&mut self.limit_explained, true),
                         ));
                     }
                     // No growth right after a cutback.

@@ -232,6 +232,32 @@ impl IncrementMeasures {
     }
 }
 
+/// The warning of an increment whose step limit even the minimum step exceeds: which limit
+/// and by how much; the first of a run (`explain`) also says whether the result is sound
+/// and what to do.
+pub fn limit_warning(which: Limit, factor: f64, dt_min: f64, explain: bool) -> String {
+    let (what, setting, column) = match which {
+        Limit::PlasticStrain => (
+            "equivalent plastic strain",
+            "max_plastic_strain_increment",
+            "max_plastic_strain_increment",
+        ),
+        Limit::Rotation => ("rotation", "max_rotation_increment", "max_rotation_increment [rad]"),
+        _ => ("slip", "max_slip_increment", "max_slip_increment"),
+    };
+    if !explain {
+        return format!(
+            "the {what} increment exceeds its limit ({setting}) by a factor {factor:.3} at the minimum step (explained at the first such increment)"
+        );
+    }
+    format!(
+        "the {what} increment exceeds its limit ({setting}) by a factor {factor:.3} even at the minimum step dt_min = {dt_min:e}. \
+         The increment is accepted: Newton converged to its tolerances, so the result is sound, but the process is followed in coarser steps than the limit asks. \
+         If that matters, lower dt_min (or raise {setting} if the coarser steps are acceptable). \
+         Not repeated: the measure of every increment is the column {column} of history.csv."
+    )
+}
+
 /// Rotation increment (radians) at an integration point: the polar rotation angle of
 /// f = F_new F_old^-1 where both gradients are well inside the physical range
 /// (det F >= 1/2), else the infinitesimal rotation |axial(skew(F_new - F_old))|, which
@@ -447,5 +473,16 @@ mod tests {
         // At dt_min an excess is accepted (and reported by the caller).
         let a = ctl.assess(&s, 3.0, 3e-6, &m, 3);
         assert!(a.accept);
+    }
+
+    #[test]
+    fn a_limit_exceeded_at_dt_min_is_explained_once_then_named_briefly() {
+        let first = limit_warning(Limit::Slip, 2.5, 0.1, true);
+        for needed in ["max_slip_increment", "2.500", "dt_min = 1e-1", "sound", "history.csv"] {
+            assert!(first.contains(needed), "{needed:?} missing from {first:?}");
+        }
+        let later = limit_warning(Limit::Rotation, 1.25, 0.1, false);
+        assert!(later.contains("max_rotation_increment") && later.contains("1.250"));
+        assert!(!later.contains("sound") && later.len() < first.len() / 2, "{later:?}");
     }
 }
