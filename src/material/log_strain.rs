@@ -68,8 +68,8 @@
 
 use super::sym_eigen3::sym_eigen3;
 use super::{
-    strain_from_tensor, stress_from_tensor, stress_to_tensor, FiniteResponse, Kinematics,
-    Material, PointState, Tangent, Voigt,
+    strain_from_tensor, stress_from_tensor, stress_to_tensor, FiniteResponse, Kinematics, Material,
+    PointState, Tangent, Voigt,
 };
 use crate::geometry::Mat3;
 use crate::{Error, Result};
@@ -450,7 +450,10 @@ mod tests {
                 let product = q.transpose() * strain_to_tensor(&e) * q;
                 for (x, y) in unit.iter().zip(product.iter()) {
                     // Equal, and zero only where both are (the sign of a zero may differ).
-                    assert!(x == y && (x.to_bits() == y.to_bits() || *x == 0.0), "{m}: {x} {y}");
+                    assert!(
+                        x == y && (x.to_bits() == y.to_bits() || *x == 0.0),
+                        "{m}: {x} {y}"
+                    );
                 }
             }
         }

@@ -180,10 +180,7 @@ mod tests {
                 }
             }
         }
-        (
-            [m[0][0], m[1][1], m[2][2]],
-            Mat3::from_fn(|i, j| v[i][j]),
-        )
+        ([m[0][0], m[1][1], m[2][2]], Mat3::from_fn(|i, j| v[i][j]))
     }
 
     /// The rotations spelled out per pair give the looped sweeps' eigenvalues and
@@ -207,14 +204,21 @@ mod tests {
             let q = SymmetricEigen::new(cases[k] * 1e3).eigenvectors;
             let spread = 10f64.powi(-9 - (k % 7) as i32);
             let d = [1e-3, 1e-3 * (1.0 + spread * rnd()), -5e-4 + 1e-3 * rnd()];
-            let d = if k % 2 == 0 { d } else { [d[0], d[1], d[0] * (1.0 - spread)] };
+            let d = if k % 2 == 0 {
+                d
+            } else {
+                [d[0], d[1], d[0] * (1.0 - spread)]
+            };
             cases.push(q * Mat3::from_diagonal(&d.into()) * q.transpose());
         }
         cases.push(Mat3::from_diagonal(&[1.0, -2.0, 0.5].into()));
         cases.push(Mat3::identity() * 3e-4);
         cases.push(Mat3::zeros());
         let bits = |lam: [f64; 3], v: Mat3| {
-            (lam.map(f64::to_bits), v.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+            (
+                lam.map(f64::to_bits),
+                v.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            )
         };
         for a in cases {
             let (l1, v1) = sym_eigen3(&a);
