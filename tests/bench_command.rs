@@ -175,6 +175,21 @@ fn baseline_runs_its_own_script_with_the_settings_it_declares() {
             m["residual_evaluations_per_iteration"].as_f64().unwrap(),
             summary["evaluations"]["residual_only"].as_f64().unwrap() / it
         );
+        let completions = summary["evaluations"]["jacobian_completions"]
+            .as_f64()
+            .unwrap();
+        assert_eq!(
+            m["completions_per_iteration"].as_f64().unwrap(),
+            completions / it
+        );
+        // The table's evaluations cell carries all three counts.
+        let cell = format!(
+            "{:.2}+{:.2}+{:.2}",
+            full / it,
+            summary["evaluations"]["residual_only"].as_f64().unwrap() / it,
+            completions / it
+        );
+        assert!(stdout.contains(&cell), "{cell} not in {stdout}");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -102,6 +102,10 @@ pub struct Measurement {
     /// not record it).
     pub full_evaluations_per_iteration: Option<f64>,
     pub residual_evaluations_per_iteration: Option<f64>,
+    /// Residual-only evaluations later given their Jacobian (an accepted line-search cut:
+    /// element tangents and assembly, no second contact pass), per Newton iteration
+    /// (`evaluations.jacobian_completions`; None for a binary that does not record it).
+    pub completions_per_iteration: Option<f64>,
     /// Seconds per phase as the run recorded them.
     pub phase_times_s: BTreeMap<String, f64>,
     pub cpu_s: Option<f64>,
@@ -417,6 +421,7 @@ fn measure(
         trials_per_iteration: (newton_iterations + line_search_cuts) as f64 / iterations,
         full_evaluations_per_iteration: per_iteration("full"),
         residual_evaluations_per_iteration: per_iteration("residual_only"),
+        completions_per_iteration: per_iteration("jacobian_completions"),
         phase_times_s,
         cpu_s,
         wall_s,
@@ -426,14 +431,17 @@ fn measure(
     })
 }
 
-/// Evaluations per iteration as `full+residual` from the run's count, else the trials per
+/// Evaluations per iteration as `full+residual+completed` from the run's count (`+c`
+/// left out for a binary that does not count its completions), else the trials per
 /// iteration marked `~` (a binary that does not count its evaluations).
 fn evaluations_cell(m: &Measurement) -> String {
     match (
         m.full_evaluations_per_iteration,
         m.residual_evaluations_per_iteration,
+        m.completions_per_iteration,
     ) {
-        (Some(f), Some(r)) => format!("{f:.2}+{r:.2}"),
+        (Some(f), Some(r), Some(c)) => format!("{f:.2}+{r:.2}+{c:.2}"),
+        (Some(f), Some(r), None) => format!("{f:.2}+{r:.2}"),
         _ => format!("~{:.2}", m.trials_per_iteration),
     }
 }
@@ -454,7 +462,7 @@ fn table(result: &CaseResult) -> String {
         None => "all processors".to_string(),
     };
     let mut s = format!(
-        "\ncase {} ({}; {threads})\n{:<9} {:>7} {:>5} {:>6} {:>5} {:>11}",
+        "\ncase {} ({}; {threads})\n{:<9} {:>7} {:>5} {:>6} {:>5} {:>16}",
         result.case.name,
         result.case.sets.join(" "),
         "binary",
@@ -462,7 +470,7 @@ fn table(result: &CaseResult) -> String {
         "incr",
         "iters",
         "cuts",
-        "evals/it"
+        "evals/it f+r+c"
     );
     for p in &phases {
         s += &format!(" {:>12}", format!("{p} s"));
@@ -473,7 +481,7 @@ fn table(result: &CaseResult) -> String {
     );
     let row = |label: &str, m: &Measurement| {
         let mut r = format!(
-            "{label:<9} {:>7} {:>5} {:>6} {:>5} {:>11}",
+            "{label:<9} {:>7} {:>5} {:>6} {:>5} {:>16}",
             m.displacement_unknowns,
             m.increments,
             m.newton_iterations,
@@ -508,7 +516,7 @@ fn table(result: &CaseResult) -> String {
         };
         let t = &result.this;
         let mut r = format!(
-            "{:<9} {:>7} {:>5} {:>6} {:>5} {:>11}",
+            "{:<9} {:>7} {:>5} {:>6} {:>5} {:>16}",
             "base/this", "", "", "", "", ""
         );
         for p in &phases {
@@ -540,6 +548,9 @@ fn table(result: &CaseResult) -> String {
         }
         s += "\n";
     }
+    s += "evals/it f+r+c: element evaluations per Newton iteration, full (with tangents) + \
+          residual-only (line-search trials) + completed (residual-only ones given their \
+          Jacobian afterwards: an accepted cut)\n";
     s
 }
 

@@ -83,6 +83,7 @@ pub fn read(path: &Path) -> Result<(SparseMatrix, Vec<f64>, Vec<usize>)> {
         col_ptr,
         row_idx,
         groups: None,
+        row_index: Default::default(),
     };
     if has_groups == 1 {
         pattern = pattern.with_groups(groups);
