@@ -242,7 +242,7 @@ fn notes(r: &ExtrapolatedReference) -> String {
         .map(|run| run.label())
         .collect();
     format!(
-        "The reference is no run of the study: it is a Richardson extrapolation, per quantity, over the stored meshes {} (0.5 mm steps; refinement ratio {:.3} and {:.3}, {}), made by runs committed with their commands in [square_cup/reference/meshes.json](./square_cup/reference/meshes.json) and not rerun by the study (table below). Its uncertainty (a GCI band, the dotted line on the chart) bounds how small an error here can be trusted: an error below it is not resolved. {} The layers family changes the through-thickness model as well as the mesh. The 16 x 16 methods family compares costs; its mesh error (the mesh family's 16 x 16 point) dominates its errors: compare each method's values with that point (in the CSV); switches that change only the Newton path (r of the augmented Lagrangian, curvature terms) give the same result on the same mesh. The step family and the 25 x 25 methods family run on 25 x 25 x 1, whose own mesh error (the mesh family's 25 x 25 point) is most of theirs.",
+        "The reference is no run of the study: it is a Richardson extrapolation, per quantity, over the stored meshes {} (0.5 mm steps; refinement ratio {:.3} and {:.3}, {}), made by runs committed with their commands in [square_cup/reference/meshes.json](./square_cup/reference/meshes.json) and not rerun by the study (table below). Its uncertainty U (a GCI band; the largest over the quantities is the dashed line 'reference uncertainty' on the chart) bounds how small an error here can be trusted: an error below it is not resolved.{} The layers family changes the through-thickness model as well as the mesh. The 16 x 16 methods family compares costs; its mesh error (the mesh family's 16 x 16 point) dominates its errors: compare each method's values with that point (in the CSV); switches that change only the Newton path (r of the augmented Lagrangian, curvature terms) give the same result on the same mesh. The step family and the 25 x 25 methods family run on 25 x 25 x 1, whose own mesh error (the mesh family's 25 x 25 point) is most of theirs.",
         r.sequence.join(", "),
         r.ratios[0],
         r.ratios[1],
@@ -255,7 +255,7 @@ fn notes(r: &ExtrapolatedReference) -> String {
             String::new()
         } else {
             format!(
-                "The other stored meshes ({}) check the extrapolation: their distance to it is in the table.",
+                " The other stored meshes ({}) check the extrapolation: their distance to it is in the table.",
                 checks.join(", ")
             )
         }
