@@ -52,6 +52,7 @@ def main(run_dir, commit):
                  "DX, DY, DD: draw-in at 15 mm [mm]; punch_force_n: peak punch force so far, full cup [N]. "
                  "The sequence 50x50x2, 25x25x1, 12x12x1: 25 -> 50 refines by 2 in-plane and through the thickness alike, "
                  "12 -> 25 by 25/12 in-plane only (one layer cannot be halved); h = (V/N)^(1/3) after Celik et al. (2008). "
+                 "24x24x2 is a check, not extrapolated from: with 12x12x1 it is ratio 2 in every direction, and beside 25x25x1 it shows the effect of the second layer. "
                  "48x48x4 (the similar sequence 12x12x1, 24x24x2, 48x48x4) was not affordable in this session. "
                  "Rule (after Eca and Hoekstra, J. Comput. Phys. 262, 2014): asymptotic when monotone with an observed order in [0.5, 2.1]; "
                  "else the formal order 2 of trilinear hexahedra in the displacements is assumed, with safety factor 3.",

@@ -8,7 +8,7 @@ set -e
 RUNS=${1:-/tmp/study_runs}
 BIN=${TRIBO:-target/release/tribo}
 mkdir -p "$RUNS"
-for m in "50 2" "25 1" "12 1"; do
+for m in "50 2" "25 1" "24 2" "12 1"; do
   set -- $m; c=$1; l=$2; d=$RUNS/c${c}_l${l}
   rm -rf "$d"
   /usr/bin/time -v -o "$RUNS/c${c}_l${l}.time" nice -n 5 taskset -c 1 "$BIN" run scripts/square_cup.rhai --quiet \
