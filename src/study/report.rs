@@ -102,8 +102,7 @@ fn case_section(o: &mut String, c: &CaseResult) {
     }
     if let Some(x) = &c.extrapolated {
         extrapolation_section(o, x);
-    }
-    if let Some(r) = &c.reference {
+    } else if let Some(r) = &c.reference {
         let _ = writeln!(
             o,
             "Reference run: {}, {:.2} s, {} Newton iterations.\n",

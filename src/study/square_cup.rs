@@ -18,7 +18,7 @@ use super::cup_reference::{self, ExtrapolatedReference, QUANTITIES};
 use super::work_precision::{
     run_families, write_case, CaseResult, Family, Labelled, Measured, Point, Values,
 };
-use super::{Cost, StudyOptions};
+use super::{Cost, Outcome, StudyOptions};
 use crate::script::{self, HostOptions};
 use crate::{Error, Result};
 use rhai::Dynamic;
@@ -293,7 +293,16 @@ fn scored(mut points: Vec<Point>, reference: ExtrapolatedReference, opts: &Study
             "max over q in (DX, DY, DD, F) of |q - q_ref| / |q_ref|: draw-in of the edge midpoints (DX, DY) and of the corner (DD), punch force at {TRAVEL} mm (F), against the Richardson extrapolation over {}",
             reference.sequence.join(", ")
         ),
-        reference: None,
+        // The extrapolated values as the reference row of the CSV (no run: no cost).
+        reference: Some(Point {
+            family: "reference".into(),
+            label: format!("Richardson extrapolation over {}", reference.sequence.join(", ")),
+            cost: Cost::default(),
+            outcome: Outcome::Converged,
+            failure: None,
+            values: reference.values(),
+            error: None,
+        }),
         notes: notes(&reference),
         points,
         command: opts.command.clone(),
@@ -330,7 +339,6 @@ pub fn rescore(opts: &StudyOptions) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::{Cost, Outcome};
 
     fn values(dx: f64, dy: f64, dd: f64, f: f64) -> Values {
         QUANTITIES
