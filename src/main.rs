@@ -40,8 +40,9 @@ enum Command {
     },
     /// Speed against accuracy: work-precision charts and stability maps with a report.
     Study {
-        /// hertz, friction_work, cylinder_drag, square_cup, stability, all, or report (only
-        /// rewrite the report from the results in the folder).
+        /// hertz, friction_work, cylinder_drag, square_cup, stability, all, report (only
+        /// rewrite the report from the results in the folder), or square_cup_rescore (measure
+        /// the stored square-cup runs against the stored reference again, without running them).
         name: String,
         /// Output folder (default: out/studies).
         #[arg(long)]

@@ -39,13 +39,13 @@ fn decades(values: impl Iterator<Item = f64>) -> (i32, i32) {
     (a, b.max(a + 1))
 }
 
-/// A log-log chart of the series, with an optional dashed horizontal line (value, label).
+/// A log-log chart of the series, with dashed horizontal lines (value, label).
 pub fn log_log(
     title: &str,
     x_label: &str,
     y_label: &str,
     series: &[LogSeries],
-    hline: Option<(f64, &str)>,
+    hlines: &[(f64, &str)],
 ) -> String {
     let (width, height) = (1040.0, 560.0);
     let (left, right, top, bottom) = (80.0, 690.0, 50.0, 500.0);
@@ -60,7 +60,7 @@ pub fn log_log(
         series
             .iter()
             .flat_map(|s| s.points.iter().filter(drawable).map(|p| p.1))
-            .chain(hline.map(|h| h.0)),
+            .chain(hlines.iter().map(|h| h.0)),
     );
     let sx = |x: f64| left + (x.log10() - x0 as f64) / (x1 - x0) as f64 * (right - left);
     let sy = |y: f64| bottom - (y.log10() - y0 as f64) / (y1 - y0) as f64 * (bottom - top);
@@ -129,7 +129,7 @@ pub fn log_log(
     let yc = (top + bottom) / 2.0;
     let turn = format!(" transform=\"rotate(-90 20 {yc:.1})\"");
     text(&mut o, 20.0, yc, 13.0, "middle", &turn, y_label);
-    if let Some((v, label)) = hline {
+    for &(v, label) in hlines.iter().filter(|h| h.0 > 0.0 && h.0.is_finite()) {
         let y = sy(v);
         let _ = writeln!(o, "<line x1=\"{left}\" y1=\"{y:.1}\" x2=\"{right}\" y2=\"{y:.1}\" stroke=\"#555555\" stroke-dasharray=\"6 4\"/>");
         text(&mut o, right - 4.0, y - 5.0, 11.0, "end", "", label);
@@ -344,8 +344,9 @@ mod tests {
                 name: "a".into(),
                 points: vec![(1.0, 0.1, "p".into()), (2.0, 0.0, "zero".into())],
             }],
-            Some((0.01, "1 %")),
+            &[(0.01, "1 %"), (0.003, "band")],
         );
+        assert!(s.contains(">band<"));
         assert!(s.starts_with("<svg") && s.ends_with("</svg>\n"));
         assert!(s.contains("t &lt;1&gt;"));
         assert!(

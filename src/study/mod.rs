@@ -3,7 +3,8 @@
 //! diverges over step size x augmentation parameter x friction coefficient.
 //!
 //! `tribo study NAME --out DIR` runs one study (`hertz`, `friction_work`, `cylinder_drag`,
-//! `square_cup`, `stability`), `all` runs every one, `report` only rewrites the report.
+//! `square_cup`, `stability`), `all` runs every one, `report` only rewrites the report,
+//! `square_cup_rescore` measures the stored square-cup runs against the stored reference again.
 //! Each study writes `DIR/NAME/results.json` (every run: its settings, wall time, Newton
 //! iterations, measured values, error or reason of failure), its charts as SVG with a CSV
 //! of their points whose first line is the command that made them, and then
@@ -15,7 +16,9 @@
 //! Runs shorter than half a second are repeated and timed by their mean.
 
 pub mod chart;
+pub mod cup_reference;
 pub mod report;
+pub mod richardson;
 pub mod scenes;
 pub mod square_cup;
 pub mod stability;
@@ -114,10 +117,11 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
     let names: Vec<&str> = match name {
         "all" => STUDIES.to_vec(),
         "report" => Vec::new(),
+        "square_cup_rescore" => vec!["square_cup_rescore"],
         n if STUDIES.contains(&n) => vec![n],
         other => {
             return Err(Error::Input(format!(
-                "unknown study '{other}' (known: {}, all, report)",
+                "unknown study '{other}' (known: {}, all, report, square_cup_rescore)",
                 STUDIES.join(", ")
             )))
         }
@@ -130,6 +134,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
         match n {
             "stability" => stability::run(opts)?,
             "square_cup" => square_cup::run(opts)?,
+            "square_cup_rescore" => square_cup::rescore(opts)?,
             case => work_precision::run(case, opts)?,
         }
         opts.note(&format!(

@@ -2,6 +2,7 @@
 //! found there: per case its chart, the cheapest run reaching 1 % error, every run in a
 //! table, the runs that failed; for the stability map the region where each method fails.
 
+use super::cup_reference::ExtrapolatedReference;
 use super::stability::StabilityResult;
 use super::work_precision::{CaseResult, Point};
 use super::{write_file, StudyOptions, STUDIES};
@@ -99,7 +100,9 @@ fn case_section(o: &mut String, c: &CaseResult) {
             );
         }
     }
-    if let Some(r) = &c.reference {
+    if let Some(x) = &c.extrapolated {
+        extrapolation_section(o, x);
+    } else if let Some(r) = &c.reference {
         let _ = writeln!(
             o,
             "Reference run: {}, {:.2} s, {} Newton iterations.\n",
@@ -138,6 +141,96 @@ fn case_section(o: &mut String, c: &CaseResult) {
         }
         o.push('\n');
     }
+}
+
+/// Short names of the extrapolated quantities, in the study's order.
+fn quantity_name(key: &str) -> &str {
+    match key {
+        "draw_in_dx_mm" => "DX [mm]",
+        "draw_in_dy_mm" => "DY [mm]",
+        "draw_in_dd_mm" => "DD [mm]",
+        "punch_force_n" => "F [N]",
+        other => other,
+    }
+}
+
+/// The extrapolated reference: per quantity the stored meshes' values, the observed order,
+/// the verdict on the asymptotic range, the extrapolated value and its GCI band; then every
+/// stored run with its cost and its distance to the reference.
+fn extrapolation_section(o: &mut String, x: &ExtrapolatedReference) {
+    let _ = writeln!(
+        o,
+        "**Reference:** Richardson extrapolation over {} ({} mm steps; runs at commit {}). Asymptotic when the convergence ratio R = (f2 - f1) / (f3 - f2) lies in (0, 1) and the observed order in [{}, {}]; then U = {} |f_ext - f1|, else order {} assumed from the two finest meshes and U = {} |f_ext - f1| (Roache's GCI; U is a band around the finest mesh's value that should hold the converged one).\n",
+        x.sequence.join(", "),
+        x.step_mm,
+        x.commit.chars().take(7).collect::<String>(),
+        x.rule.min,
+        x.rule.max,
+        super::richardson::SAFETY_ASYMPTOTIC,
+        x.rule.assumed,
+        super::richardson::SAFETY_ASSUMED,
+    );
+    let _ = writeln!(
+        o,
+        "| quantity | {} | observed order | R | verdict | reference | U | U / reference | finest mesh's error |",
+        x.sequence.join(" | ")
+    );
+    let _ = writeln!(o, "|---|{}---|---|---|---|---|---|---|", "---|".repeat(x.sequence.len()));
+    for (key, e) in &x.quantities {
+        let values: Vec<String> = x
+            .sequence
+            .iter()
+            .map(|label| {
+                x.runs
+                    .iter()
+                    .find(|r| &r.label() == label)
+                    .and_then(|r| r.values.get(key))
+                    .map(|v| format!("{v:.5}"))
+                    .unwrap_or_else(|| "-".into())
+            })
+            .collect();
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} | {:.3} | {} | {:.5} | {:.3e} | {:.2e} | {:.2e} |",
+            quantity_name(key),
+            values.join(" | "),
+            e.observed_order
+                .map(|p| format!("{p:.2}"))
+                .unwrap_or_else(|| "-".into()),
+            e.convergence_ratio,
+            e.verdict,
+            e.value,
+            e.uncertainty,
+            e.relative_uncertainty,
+            e.finest_error
+        );
+    }
+    let _ = writeln!(
+        o,
+        "\nStored runs (CPU seconds of the whole run, one element thread, niced on the shared machine; error as in the chart):\n"
+    );
+    let _ = writeln!(o, "| mesh | CPU [s] | wall [s] | Newton iterations | increments (cutbacks) | error against the reference | command |");
+    let _ = writeln!(o, "|---|---|---|---|---|---|---|");
+    let reference = x.values();
+    for r in &x.runs {
+        let error = reference
+            .iter()
+            .filter_map(|(k, v)| r.values.get(k).map(|m| (m - v).abs() / v.abs()))
+            .fold(0.0, f64::max);
+        let _ = writeln!(
+            o,
+            "| {} | {:.1} | {:.1} | {} | {} ({}) | {:.2e} | `{}` |",
+            r.label(),
+            r.cpu_s,
+            r.wall_s,
+            r.iterations,
+            r.increments,
+            r.cutbacks,
+            error,
+            r.command
+        );
+    }
+    o.push('\n');
 }
 
 fn stability_section(o: &mut String, s: &StabilityResult) {

@@ -18,6 +18,7 @@
 //! A run that stops (no convergence) is kept with its outcome and no error.
 
 use super::chart::{log_log, LogSeries};
+use super::cup_reference::ExtrapolatedReference;
 use super::scenes;
 use super::{seconds, write_file, Cost, Outcome, StudyOptions, Variant};
 use crate::contact::{Enforcement, FrameUpdate, FrictionUpdate};
@@ -72,6 +73,10 @@ pub struct CaseResult {
     pub notes: String,
     pub points: Vec<Point>,
     pub command: String,
+    /// The extrapolated reference the errors are measured against, when there is one
+    /// (the square cup's).
+    #[serde(default)]
+    pub extrapolated: Option<ExtrapolatedReference>,
 }
 
 /// Runs shorter than this many seconds are repeated and timed by their mean.
@@ -391,6 +396,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
             notes: "The problem is linear up to the contact zone, so the number of increments changes the cost only. Penalty at and above the default r gives errors of the size of the mesh error with either sign (the penetration widens the contact and offsets part of the coarse mesh's error); below it the penetration dominates.".into(),
             points: run_families(&hertz_families(), None, &hertz_measure, &hertz_error, Some(opts))?.1,
             command: opts.command.clone(),
+            extrapolated: None,
         },
         "friction_work" => CaseResult {
             name: name.into(),
@@ -400,6 +406,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
             notes: "Every node slips exactly the prescribed distance, so the only error is the time discretisation of the friction update: first order explicit, second order implicit (tests/friction_work.rs). These runs last milliseconds; their wall time is the mean of repeats and mostly fixed set-up cost.".into(),
             points: run_families(&friction_work_families(), None, &friction_work_measure, &friction_work_error, Some(opts))?.1,
             command: opts.command.clone(),
+            extrapolated: None,
         },
         "cylinder_drag" => {
             let reference = drag_reference();
@@ -413,6 +420,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
                 notes: "The contact force ripples as the cylinder passes over the nodes (node-to-surface contact: on 32 cells the normal force is 68.4 with the cylinder over a node and 64.4 between two, in steady sliding); the increments sample that ripple, and an increment that is a multiple of the cell size samples it at one phase only, so the error need not fall monotonically under step refinement on a fixed mesh, nor under mesh refinement at a fixed number of increments. The reference has an error of its own, so the errors of the finest runs are underestimated.".into(),
                 points,
                 command: opts.command.clone(),
+            extrapolated: None,
             }
         }
         other => return Err(Error::Input(format!("no work-precision case named '{other}'"))),
@@ -444,12 +452,17 @@ pub fn write_case(result: &CaseResult, opts: &StudyOptions) -> Result<()> {
                 .collect(),
         })
         .collect();
+    let uncertainty = result
+        .extrapolated
+        .as_ref()
+        .map(|r| (r.worst_relative_uncertainty(), "reference uncertainty"));
+    let hlines: Vec<(f64, &str)> = [Some((0.01, "1 %")), uncertainty].into_iter().flatten().collect();
     let svg = log_log(
         &format!("{}: error against wall time", result.title),
         "wall time of the whole run [s]",
         "relative error",
         &series,
-        Some((0.01, "1 %")),
+        &hlines,
     );
     write_file(&dir.join("work_precision.svg"), &svg)?;
     write_file(&dir.join("work_precision.csv"), &points_csv(result))?;
