@@ -454,6 +454,40 @@ pub(super) fn cholesky_excess(a: &Mat3) -> Result<Mat3> {
     Ok(h)
 }
 
+/// The Cauchy stress of the PK2 stress `s` at the enhanced Green-Lagrange strain `e`
+/// (engineering shears), oriented by the compatible deformation gradient `f`:
+/// `σ = Q F̃ S F̃ᵀ Qᵀ / det F̃`, `F̃ = I + h` the Cholesky stretch of `C = I + 2E`
+/// ([`cholesky_excess`]) and `Q` the rotation of the polar decomposition of `f F̃⁻¹`. Why
+/// not `f S fᵀ / det f`: the compatible `f` lacks the enhanced thickness strain, which in
+/// bending is the Poisson contraction `∓ν κ z`: pushing forward with it put the faces'
+/// von Mises stress 3.5 % off the yield stress at a bending radius of 20 thicknesses. The
+/// stretch is the material's, the rotation the element's (objective). `Q` by Higham's
+/// iteration `X ← (X + X⁻ᵀ)/2`, quadratic, 3-5 steps from a near-rotation.
+pub(super) fn cauchy_stress(f: &Mat3, e: &Voigt, s: &Voigt) -> Result<Voigt> {
+    let stretch = Mat3::identity() + cholesky_excess(&(strain_to_tensor(e) * 2.0))?;
+    let inverse = stretch
+        .try_inverse()
+        .ok_or_else(|| Error::NoConvergence("singular enhanced stretch".into()))?;
+    let mut q = f * inverse;
+    for _ in 0..20 {
+        let Some(inv) = q.try_inverse() else {
+            return Err(Error::NoConvergence(
+                "singular deformation gradient in the stress output".into(),
+            ));
+        };
+        let next = (q + inv.transpose()) * 0.5;
+        let change = (next - q).norm();
+        q = next;
+        if change < 1e-12 {
+            break;
+        }
+    }
+    let qf = q * stretch;
+    Ok(stress_from_tensor(
+        &(qf * stress_to_tensor(s) * qf.transpose() / stretch.determinant()),
+    ))
+}
+
 /// `K_αα⁻¹ rhs` for the `ne` active enhanced parameters (identity rows for the inactive
 /// ones, whose modes and right-hand sides are zero).
 fn solve_enhanced<const C: usize>(
@@ -651,22 +685,22 @@ impl SolidShell {
         }
     }
 
-    /// The output part of a converged point's `trial`: Cauchy stress (finite strain: PK2
-    /// `s` pushed forward with the compatible `F`), `F` and the enhanced parameters.
+    /// The output part of a converged point's `trial`: Cauchy stress (finite strain:
+    /// [`cauchy_stress`]), `F` and the enhanced parameters.
     fn finish_point(
         &self,
         point: &Point,
         s: &Voigt,
         alpha: &SVector<f64, ENHANCED_PARAMETERS>,
         trial: &mut PointState,
-    ) {
+    ) -> Result<()> {
         if self.finite {
-            let f = &point.f;
-            let j = f.determinant();
-            trial.stress = stress_from_tensor(&(f * stress_to_tensor(s) * f.transpose() / j));
+            let e = point.strain + point.modes * alpha;
+            trial.stress = cauchy_stress(&point.f, &e, s)?;
         }
         trial.deformation_gradient = point.f;
         trial.enhanced = (*alpha).into();
+        Ok(())
     }
 
     /// Adds the geometric stiffness `Σ_c S^c ∂²E_c/∂u²` of every point to `k`: the
@@ -823,7 +857,7 @@ impl Element<DOFS> for SolidShell {
         let mut f = SVector::<f64, DOFS>::zeros();
         for ((point, s), state) in points.iter().zip(&stresses).zip(trial.iter_mut()) {
             f.gemv_tr(point.dv, &point.b, s, 1.0);
-            self.finish_point(point, s, &alpha, state);
+            self.finish_point(point, s, &alpha, state)?;
         }
         force.copy_from_slice(f.as_slice());
         let Some(k_out) = stiffness else {
