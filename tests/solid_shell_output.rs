@@ -188,15 +188,11 @@ fn thickness_strain_at_the_levels_matches_the_element_thickness() {
     let t0 = 0.8;
     let mesh = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 1.0, t0), [2, 1, 1]).unwrap();
     let mut model = Model::new(mesh, Arc::new(steel())).unwrap();
-    model
-        .prescribe("x-", "x", ScalarSchedule::constant(0.0))
-        .unwrap();
-    model
-        .prescribe("y-", "y", ScalarSchedule::constant(0.0))
-        .unwrap();
-    model
-        .prescribe("z-", "z", ScalarSchedule::constant(0.0))
-        .unwrap();
+    for (set, c) in [("x-", "x"), ("y-", "y"), ("z-", "z")] {
+        model
+            .prescribe(set, c, ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
     model
         .prescribe(
             "x+",
