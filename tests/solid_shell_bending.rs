@@ -15,6 +15,7 @@
 
 use std::sync::Arc;
 
+use tribo::element::solid_shell::DEFAULT_THICKNESS_POINTS;
 use tribo::element::{ElementKind, StrainTheory};
 use tribo::geometry::Vec3;
 use tribo::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
@@ -44,7 +45,7 @@ struct Curve {
     iterations: Vec<usize>,
 }
 
-fn bend(kind: ElementKind, layers: usize, elastic: bool) -> Curve {
+fn bend(kind: ElementKind, layers: usize, elastic: bool, points: usize) -> Curve {
     let mut mesh = Mesh::block(
         Vec3::new(0.0, 0.0, -T / 2.0),
         Vec3::new(SLICE, SLICE, T),
@@ -102,7 +103,7 @@ fn bend(kind: ElementKind, layers: usize, elastic: bool) -> Curve {
     }
     model.settings.kinematics = StrainTheory::Finite;
     model.settings.element = kind;
-    model.settings.thickness_points = 5;
+    model.settings.thickness_points = points;
     model.settings.end_time = 2.0;
     model.settings.increments = STEPS;
     model.settings.max_cutbacks = 0;
@@ -166,8 +167,8 @@ fn springback(c: &Curve) -> f64 {
 /// `1/(100 t)` (printed; neither is converged there: the crude closed form lies between).
 #[test]
 fn one_solid_shell_layer_bends_and_springs_back_like_eight_fbar_layers() {
-    let shell = bend(ElementKind::SolidShell, 1, false);
-    let fbar = bend(ElementKind::Hexahedron, 8, false);
+    let shell = bend(ElementKind::SolidShell, 1, false, 5);
+    let fbar = bend(ElementKind::Hexahedron, 8, false, 5);
     let peak = shell.moment.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut worst: f64 = 0.0;
     for i in 0..STEPS {
@@ -210,12 +211,45 @@ fn one_solid_shell_layer_bends_and_springs_back_like_eight_fbar_layers() {
 /// bending energy).
 #[test]
 fn elastic_bending_moment_is_plate_theory() {
-    let shell = bend(ElementKind::SolidShell, 1, true);
-    let fbar = bend(ElementKind::Hexahedron, 8, true);
+    let shell = bend(ElementKind::SolidShell, 1, true, 5);
+    let fbar = bend(ElementKind::Hexahedron, 8, true, 5);
     let exact = 210e3 / (1.0 - 0.09) * shell.kappa[0] * T.powi(3) / 12.0;
     println!(
         "elastic: solid-shell {:.6}, F-bar {:.6}, plate theory {exact:.6}",
         -shell.moment[0], -fbar.moment[0]
     );
     assert!((-shell.moment[0] / exact - 1.0).abs() < 1e-4);
+}
+
+/// The default thickness rule follows the elastic-plastic transition: with
+/// `DEFAULT_THICKNESS_POINTS` (11) one layer's moment is within 1.5 % of the 8 F-bar layers'
+/// at every loading increment, from the first (`R = 200 t`, where 5 points are 4.3 % off)
+/// on, and within 1 % from `R = 50 t` on. Why 1.5 % in the transition: the 11-point rule is
+/// within 1.1 % of the analytic moment-curvature there and the F-bar reference within
+/// 0.23 % (docs/solid_shell_transition.py), so their difference may reach ~1.3 %.
+#[test]
+fn default_thickness_rule_follows_the_elastic_plastic_transition() {
+    let shell = bend(ElementKind::SolidShell, 1, false, DEFAULT_THICKNESS_POINTS);
+    let fbar = bend(ElementKind::Hexahedron, 8, false, 5);
+    let five = bend(ElementKind::SolidShell, 1, false, 5);
+    let mut worst_transition: f64 = 0.0;
+    let mut worst_plastic: f64 = 0.0;
+    for i in 0..STEPS / 2 {
+        let d = shell.moment[i] / fbar.moment[i] - 1.0;
+        println!(
+            "κ {:.4}: {DEFAULT_THICKNESS_POINTS} points {:+.3} %, 5 points {:+.3} % against 8 F-bar layers",
+            shell.kappa[i],
+            100.0 * d,
+            100.0 * (five.moment[i] / fbar.moment[i] - 1.0)
+        );
+        if shell.kappa[i] >= TRANSITION {
+            worst_plastic = worst_plastic.max(d.abs());
+        } else {
+            worst_transition = worst_transition.max(d.abs());
+        }
+    }
+    assert!(worst_transition < 0.015, "transition {worst_transition}");
+    assert!(worst_plastic < 0.01, "plastic {worst_plastic}");
+    // The 5-point rule does not (the reason for the default).
+    assert!((five.moment[0] / fbar.moment[0] - 1.0).abs() > 0.02);
 }

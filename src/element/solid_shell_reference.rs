@@ -13,8 +13,8 @@ use super::solid_shell::{
 };
 use crate::geometry::{Mat3, Vec3};
 use crate::material::{
-    strain_from_tensor, strain_to_tensor, stress_from_tensor, stress_to_tensor, Kinematics,
-    Material, PointState, Tangent, Voigt, ENHANCED_PARAMETERS,
+    strain_from_tensor, strain_to_tensor, Kinematics, Material, PointState, Tangent, Voigt,
+    ENHANCED_PARAMETERS,
 };
 use crate::{Error, Result};
 
@@ -233,10 +233,7 @@ impl Reference<'_> {
         let (s, c) = if self.finite {
             let h = stretch_minus_identity(&(strain_to_tensor(&e) * 2.0))?;
             let resp = material.update_finite_displacement_gradient(&h, committed, trial)?;
-            let f = &point.f;
-            let j = f.determinant();
-            trial.stress =
-                stress_from_tensor(&(f * stress_to_tensor(&resp.pk2) * f.transpose() / j));
+            trial.stress = super::solid_shell::cauchy_stress(&point.f, &e, &resp.pk2)?;
             (resp.pk2, resp.tangent)
         } else {
             let kin = Kinematics {

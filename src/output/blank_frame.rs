@@ -128,7 +128,8 @@ fn nodal_contact(sim: &Simulation, only: Option<usize>) -> NodalContact {
 /// fields on the nodes (and, for sheet meshes with through-thickness columns, the current
 /// thickness and the thickness strain ln(t/t0) of each column on its nodes),
 /// element-averaged Cauchy stress (components named xx, yy, zz, xy, yz, xz), von Mises
-/// stress and equivalent plastic strain on the cells.
+/// stress and equivalent plastic strain on the cells; for solid-shell models also the values
+/// at the faces and the mid-surface (`shell_layers`).
 pub fn frame(sim: &Simulation, configuration: Configuration) -> Frame {
     frame_against(sim, configuration, None)
 }
@@ -203,6 +204,9 @@ pub fn frame_against(sim: &Simulation, configuration: Configuration, only: Optio
             Field::symmetric_tensor("stress", stress),
             Field::scalar("von_mises", von_mises),
             Field::scalar("equivalent_plastic_strain", eq_plastic),
-        ],
+        ]
+        .into_iter()
+        .chain(super::shell_layers::cell_fields(sim))
+        .collect(),
     }
 }

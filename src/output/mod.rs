@@ -18,6 +18,7 @@ mod field_map;
 mod folder;
 mod line_chart;
 mod pvd;
+mod shell_layers;
 mod summary;
 pub mod svg;
 mod tool_frame;

@@ -268,7 +268,7 @@ impl Simulations {
 }
 
 impl SimState {
-    fn model_mut(&mut self) -> ScriptResult<&mut Model> {
+    pub(super) fn model_mut(&mut self) -> ScriptResult<&mut Model> {
         match self.model.as_mut() {
             Some(m) => Ok(m),
             None => runtime_error("the model cannot be changed after the simulation has started"),

@@ -11,6 +11,7 @@ mod api_mesh_map;
 mod api_numbers;
 mod api_round_blank;
 mod api_scene;
+mod api_shell;
 mod api_sim;
 mod api_tools;
 mod convert;
@@ -117,6 +118,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     api_sim::register(&mut engine, host.clone());
     api_charts::register(&mut engine, host);
     api_mesh_map::register(&mut engine);
+    api_shell::register(&mut engine);
     api_numbers::register(&mut engine);
     register_checks(&mut engine);
     engine
