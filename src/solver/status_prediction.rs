@@ -112,7 +112,13 @@ impl Simulation {
             ctx.forced = Some(forced);
             let held = ctx.evaluate(x, times);
             ctx.forced = None;
-            step = self.newton_step(&held?, linear)?;
+            // A predicted set can leave a body held by nothing (every node of a
+            // force-controlled holder predicted to lift off): a singular system, the plain
+            // step then.
+            match self.newton_step(&held?, linear) {
+                Ok(s) => step = s,
+                Err(_) => return Ok(dx),
+            }
             used = predicted;
             resolved = true;
         }
