@@ -5,7 +5,7 @@ pub mod operator;
 pub mod state;
 
 pub use friction::{BernsteinLaw, FrictionInput, FrictionLaw, FrictionUpdate, WorkMeasure};
-pub use operator::{alart_curnier, ContactStatus, NodalContact, OperatorParams};
+pub use operator::{alart_curnier, ContactStatus, NodalContact, OperatorParams, SigmaModel};
 pub use state::ContactNodeState;
 
 /// How contact constraints are enforced.

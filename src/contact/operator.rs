@@ -81,6 +81,64 @@ pub struct NodalContact {
     /// Tangential part of F_equi (the friction force on the tool): sigma_t in stick,
     /// -mu sigma_n t in slip, exactly zero for mu = 0 and in a gap (for frictional work).
     pub tangential_force: Vec3,
+    /// The augmented multiplier and its linearisation, from which the status at a nearby
+    /// state is predicted (`solver::status_prediction`); None where the node has no
+    /// projection on the tool (it stays in gap).
+    pub sigma_model: Option<SigmaModel>,
+}
+
+/// `sigma = lambda + r g` at the evaluated state and its first-order change,
+/// `sigma + dsigma_x du + dlambda` (the normal held fixed), with the status law's mu and r.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SigmaModel {
+    pub sigma: Vec3,
+    pub dsigma_x: Mat3,
+    pub normal: Vec3,
+    pub mu: f64,
+    pub r: f64,
+}
+
+impl SigmaModel {
+    /// The exact operator's status at `sigma + dsigma_x du + dlambda`: what the node's
+    /// status becomes after the Newton step (du, dlambda) if the operator were linear.
+    /// A change from `current` counts only beyond `APEX_BAND r` of the boundary crossed
+    /// (round-off-sized moves, e.g. of a node touching with a zero multiplier, keep the
+    /// status: the prediction must not depend on the linear solver's round-off).
+    pub fn predicted_status(
+        &self,
+        du: &Vec3,
+        dlambda: &Vec3,
+        current: ContactStatus,
+    ) -> ContactStatus {
+        let s = self.sigma + self.dsigma_x * du + dlambda;
+        let predicted = status_of(&s, &self.normal, self.mu);
+        let sigma_n = s.dot(&self.normal);
+        let cone = (s - self.normal * sigma_n).norm() + self.mu * sigma_n;
+        let band = APEX_BAND * self.r;
+        let clear = match (current, predicted) {
+            (a, b) if a == b => true,
+            (ContactStatus::Gap, _) | (_, ContactStatus::Gap) => sigma_n.abs() > band,
+            _ => cone.abs() > band,
+        };
+        if clear {
+            predicted
+        } else {
+            current
+        }
+    }
+}
+
+/// Gap when sigma_n > 0, stick inside the Coulomb cone, slip outside.
+fn status_of(sigma: &Vec3, n: &Vec3, mu: f64) -> ContactStatus {
+    let sigma_n = sigma.dot(n);
+    let sigma_t = sigma - n * sigma_n;
+    if sigma_n > 0.0 {
+        ContactStatus::Gap
+    } else if sigma_t.norm() + mu * sigma_n <= 0.0 {
+        ContactStatus::Stick
+    } else {
+        ContactStatus::Slip
+    }
 }
 
 /// Inputs of the nodal operator besides the geometry.
@@ -152,13 +210,7 @@ pub fn alart_curnier(
     let dsigma_x = a * r;
     let dsigma_n_x = n.transpose() * dsigma_x + sigma.transpose() * g_mat;
 
-    let natural = if sigma_n > 0.0 {
-        ContactStatus::Gap
-    } else if sigma_t.norm() + mu * sigma_n <= 0.0 {
-        ContactStatus::Stick
-    } else {
-        ContactStatus::Slip
-    };
+    let natural = status_of(&sigma, &n, mu);
     let chosen = match params.forced {
         Some(ContactStatus::Slip) if sigma_t.norm() == 0.0 => ContactStatus::Stick,
         Some(s) => s,
@@ -217,6 +269,13 @@ pub fn alart_curnier(
         suppl_lambda: (equi_lambda - ident) / r,
         slip_increment: delta_t,
         tangential_force,
+        sigma_model: Some(SigmaModel {
+            sigma,
+            dsigma_x,
+            normal: n,
+            mu,
+            r,
+        }),
     }
 }
 
@@ -250,6 +309,55 @@ mod tests {
         let res = alart_curnier(&x, &x, &(n * -1e-3), &proj, &p);
         assert_eq!(res.status, ContactStatus::Stick);
         assert!((res.equi_lambda - Mat3::identity()).norm() < 1e-15);
+    }
+
+    #[test]
+    fn predicted_status_is_the_status_after_the_step_on_a_plane() {
+        // On a plane without curvature sigma is affine in (x, lambda): the first-order model
+        // is exact, so the predicted status is the operator's status at the stepped state.
+        let proj = |x: &Vec3| Projection {
+            foot: Vec3::new(x[0], x[1], 0.0),
+            normal: Vec3::z(),
+            gap: x[2],
+            normal_gradient: Mat3::zeros(),
+            hint: SurfaceHint::default(),
+        };
+        let p = OperatorParams::fixed_mu(100.0, 0.3, false);
+        let x_ref = Vec3::zeros();
+        let start = [
+            (Vec3::new(0.0, 0.0, 0.01), Vec3::zeros()),
+            (Vec3::new(0.001, 0.0, -0.01), Vec3::new(0.0, 0.0, -5.0)),
+            (Vec3::new(0.05, 0.0, -0.01), Vec3::new(1.0, 0.0, -5.0)),
+        ];
+        let steps = [
+            (Vec3::new(0.0, 0.0, -0.03), Vec3::zeros()),
+            (Vec3::new(0.04, -0.02, 0.0), Vec3::new(0.0, 0.5, 0.0)),
+            (Vec3::new(0.0, 0.0, 0.03), Vec3::new(0.0, 0.0, 4.0)),
+            (Vec3::new(-0.05, 0.0, 0.0), Vec3::new(-1.0, 0.0, 0.0)),
+        ];
+        let mut changed = 0;
+        for (x, l) in start {
+            let here = alart_curnier(&x, &x_ref, &l, &proj(&x), &p);
+            let model = here.sigma_model.expect("a projection");
+            for (du, dl) in steps {
+                let (xs, ls) = (x + du, l + dl);
+                let there = alart_curnier(&xs, &x_ref, &ls, &proj(&xs), &p);
+                assert_eq!(model.predicted_status(&du, &dl, here.status), there.status);
+                changed += usize::from(there.status != here.status);
+            }
+            // A round-off-sized move keeps the status, whatever side it lands on.
+            let at_apex = alart_curnier(&x_ref, &x_ref, &Vec3::zeros(), &proj(&x_ref), &p);
+            let m = at_apex.sigma_model.unwrap();
+            let tiny = Vec3::new(0.0, 0.0, 1e-14);
+            assert_eq!(
+                m.predicted_status(&tiny, &Vec3::zeros(), at_apex.status),
+                at_apex.status
+            );
+        }
+        assert!(
+            changed >= 6,
+            "the steps cross status boundaries ({changed})"
+        );
     }
 
     #[test]

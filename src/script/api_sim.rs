@@ -728,6 +728,7 @@ pub const SETTING_KEYS: &[&str] = &[
     "eliminate_multipliers",
     "linear_solver",
     "extrapolate",
+    "status_prediction",
     "threads",
     "kinematics",
     "fbar",
@@ -784,6 +785,7 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
                 }
             }
             "cycle_flips" => step.cycle_flips = count(key)?,
+            "status_prediction" => s.status_prediction = count(key)?,
             "rollback_depth" => step.rollback_depth = count(key)?,
             "checkpoint_every" => st.checkpoint_every = count(key)?,
             "increments" => {

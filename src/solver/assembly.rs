@@ -628,6 +628,7 @@ fn far_from_tool(lambda: &Vec3, r: f64) -> NodalContact {
         suppl_lambda: -Mat3::identity() / r,
         slip_increment: Vec3::zeros(),
         tangential_force: Vec3::zeros(),
+        sigma_model: None,
     }
 }
 

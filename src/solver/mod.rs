@@ -17,6 +17,7 @@ pub mod predictor;
 pub mod simulation;
 pub mod slots;
 pub mod sparse;
+pub mod status_prediction;
 pub mod step_control;
 pub mod symmetric_lu;
 pub mod system_dump;

@@ -388,6 +388,21 @@ impl Simulation {
                 Some(dx) => dx,
                 None => self.newton_step(&eval, linear)?,
             };
+            // Frozen statuses (anti-cycling) are a problem of their own: not re-linearised.
+            let dx = if settings.status_prediction > 0 && ctx.forced.is_none() {
+                self.status_consistent_step(
+                    &mut ctx,
+                    &x,
+                    &eval,
+                    dx,
+                    linear,
+                    &mut times,
+                    settings.status_prediction,
+                    (merit, &weights),
+                )?
+            } else {
+                dx
+            };
             times.factorization_and_solve += ts.elapsed().as_secs_f64();
             if let Some(last) = residuals.last_mut() {
                 last.correction = norm(&dx[..n_u]);

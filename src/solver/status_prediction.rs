@@ -1,0 +1,135 @@
+//! Newton steps linearised on the contact statuses they lead to (status prediction).
+//!
+//! The semismooth Newton step at `x` linearises every contact node on the status (gap,
+//! stick, slip) its augmented multiplier `sigma` has at `x`. Where a step carries `sigma`
+//! of many barely touching nodes across a status boundary, that linearisation is wrong for
+//! them: after the step they bring `r` times their gap error into their equilibrium rows,
+//! the merit rises, the line search cuts the step, and the next iterate flips a few nodes
+//! only. On the 25 x 25 x 1 square cup that node-by-node march is most of an increment's
+//! iterations (docs/convergence.md).
+//!
+//! Here the step is solved again with each such node linearised on the status it would
+//! have at the step's end, predicted from the first-order model of `sigma`
+//! ([`crate::contact::SigmaModel`]: `sigma + dsigma/dx du + dlambda`, the tool moved by its
+//! offset's change), until the statuses used and the statuses predicted agree (a step of
+//! the piecewise-linear Newton model, Josephy-Newton) or `rounds` re-solves are spent.
+//! A node linearised on a predicted status carries that status's branch in its residual
+//! at `x` too (`IncrementContext::forced`), so each re-solve is the Newton step of the
+//! branch the node is heading into. Only the step changes: the line search and the
+//! convergence test use the exact law, so the converged answer is the same.
+//!
+//! Cost per re-solve: one evaluation and one linear solve; the prediction itself is O(1)
+//! per contact pair.
+
+use super::assembly::{DofMap, Evaluation, IncrementContext, PhaseTimes};
+use super::linear::LinearSolver;
+use super::model::Model;
+use super::simulation::Simulation;
+use crate::contact::ContactStatus;
+use crate::geometry::Vec3;
+use crate::Result;
+
+/// Status per (tool, candidate).
+type Statuses = Vec<Vec<ContactStatus>>;
+
+/// The statuses of an evaluation.
+pub fn statuses(eval: &Evaluation) -> Statuses {
+    eval.nodal
+        .iter()
+        .map(|list| list.iter().map(|(n, _)| n.status).collect())
+        .collect()
+}
+
+/// The status every contact pair of `eval` would have after the step `dx`, from the
+/// first-order model of its augmented multiplier. A pair without a multiplier unknown
+/// (penalty) or without a projection keeps its status.
+pub fn predicted_statuses(model: &Model, dofs: &DofMap, eval: &Evaluation, dx: &[f64]) -> Statuses {
+    eval.nodal
+        .iter()
+        .enumerate()
+        .map(|(c, list)| {
+            let contact = &model.contacts[c];
+            let tool_shift = match (&contact.tool.force_control, dofs.tool_offset[c]) {
+                (Some(fc), Some(s)) => fc.axis * dx[s],
+                _ => Vec3::zeros(),
+            };
+            list.iter()
+                .enumerate()
+                .map(|(k, (result, _))| {
+                    let (Some(m), Some(off)) = (result.sigma_model, dofs.lambda_offset[c]) else {
+                        return result.status;
+                    };
+                    let node = contact.candidates[k];
+                    let du = Vec3::new(dx[3 * node], dx[3 * node + 1], dx[3 * node + 2]);
+                    let l = off + 3 * k;
+                    let dlambda = Vec3::new(dx[l], dx[l + 1], dx[l + 2]);
+                    m.predicted_status(&(du - tool_shift), &dlambda, result.status)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+impl Simulation {
+    /// The Newton step `dx` solved at the evaluation `eval` of `x`, re-solved up to `rounds`
+    /// times with the contact pairs whose predicted status differs from their status at `x`
+    /// linearised on the predicted one (see the module doc). The re-solved step is kept only
+    /// if its full step lowers the merit below `merit_at_x` (`(merit, weights)` of
+    /// `residual_record`; one residual-only evaluation): where a step flips hundreds of
+    /// nodes at once (a flat blank touching every tool at zero gap) the predicted branches
+    /// can lead far from the solution, and the plain step with its line search is safer.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn status_consistent_step(
+        &self,
+        ctx: &mut IncrementContext<'_>,
+        x: &[f64],
+        eval: &Evaluation,
+        dx: Vec<f64>,
+        linear: &mut dyn LinearSolver,
+        times: &mut PhaseTimes,
+        rounds: usize,
+        (merit_at_x, weights): (f64, &[f64]),
+    ) -> Result<Vec<f64>> {
+        let at_x = statuses(eval);
+        let mut used = at_x.clone();
+        let mut step = dx.clone();
+        let mut resolved = false;
+        for _ in 0..rounds {
+            let predicted = predicted_statuses(&self.model, &self.dofs, eval, &step);
+            if predicted == used {
+                break;
+            }
+            let forced = predicted
+                .iter()
+                .zip(&at_x)
+                .map(|(p, a)| {
+                    p.iter()
+                        .zip(a)
+                        .map(|(p, a)| (p != a).then_some(*p))
+                        .collect()
+                })
+                .collect();
+            ctx.forced = Some(forced);
+            let held = ctx.evaluate(x, times);
+            ctx.forced = None;
+            // A predicted set can leave a body held by nothing (every node of a
+            // force-controlled holder predicted to lift off): a singular system, the plain
+            // step then.
+            match self.newton_step(&held?, linear) {
+                Ok(s) => step = s,
+                Err(_) => return Ok(dx),
+            }
+            used = predicted;
+            resolved = true;
+        }
+        if !resolved {
+            return Ok(dx);
+        }
+        let xt: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + b).collect();
+        let merit = ctx
+            .evaluate_residual(&xt, times)
+            .map(|e| self.residual_record(&e, weights).1)
+            .unwrap_or(f64::INFINITY);
+        Ok(if merit < merit_at_x { step } else { dx })
+    }
+}
