@@ -89,9 +89,7 @@ impl Simulation {
             }
             alpha *= 0.5;
         }
-        let kink_near_start = best
-            .as_ref()
-            .is_none_or(|b| b.0 > KINK_MERIT_RISE * merit0);
+        let kink_near_start = best.as_ref().is_none_or(|b| b.0 > KINK_MERIT_RISE * merit0);
         let deep = if kink_near_start { DEEP_CUTS } else { 0 };
         for cut in LINE_SEARCH_CUTS + 1..=LINE_SEARCH_CUTS + deep {
             let xn = trial_x(alpha);

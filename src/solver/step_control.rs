@@ -242,7 +242,11 @@ pub fn limit_warning(which: Limit, factor: f64, dt_min: f64, explain: bool) -> S
             "max_plastic_strain_increment",
             "max_plastic_strain_increment",
         ),
-        Limit::Rotation => ("rotation", "max_rotation_increment", "max_rotation_increment [rad]"),
+        Limit::Rotation => (
+            "rotation",
+            "max_rotation_increment",
+            "max_rotation_increment [rad]",
+        ),
         _ => ("slip", "max_slip_increment", "max_slip_increment"),
     };
     if !explain {
@@ -478,11 +482,20 @@ mod tests {
     #[test]
     fn a_limit_exceeded_at_dt_min_is_explained_once_then_named_briefly() {
         let first = limit_warning(Limit::Slip, 2.5, 0.1, true);
-        for needed in ["max_slip_increment", "2.500", "dt_min = 1e-1", "sound", "history.csv"] {
+        for needed in [
+            "max_slip_increment",
+            "2.500",
+            "dt_min = 1e-1",
+            "sound",
+            "history.csv",
+        ] {
             assert!(first.contains(needed), "{needed:?} missing from {first:?}");
         }
         let later = limit_warning(Limit::Rotation, 1.25, 0.1, false);
         assert!(later.contains("max_rotation_increment") && later.contains("1.250"));
-        assert!(!later.contains("sound") && later.len() < first.len() / 2, "{later:?}");
+        assert!(
+            !later.contains("sound") && later.len() < first.len() / 2,
+            "{later:?}"
+        );
     }
 }

@@ -140,7 +140,10 @@ impl StoredSequence {
             .iter()
             .map(|[c, l]| self.run(*c, *l))
             .collect::<Result<Vec<_>>>()?;
-        let h: Vec<f64> = runs.iter().map(|r| self.cell_size(r.cells, r.layers)).collect();
+        let h: Vec<f64> = runs
+            .iter()
+            .map(|r| self.cell_size(r.cells, r.layers))
+            .collect();
         let similar = runs.windows(2).all(|w| {
             let plane = f64::from(w[0].cells) / f64::from(w[1].cells);
             let thick = f64::from(w[0].layers) / f64::from(w[1].layers);
@@ -159,7 +162,10 @@ impl StoredSequence {
             let levels = [0, 1, 2].map(|i| (h[i], runs[i]));
             let mut l = [Level { h: 0.0, value: 0.0 }; 3];
             for (slot, (h, r)) in l.iter_mut().zip(levels) {
-                *slot = Level { h, value: value(r)? };
+                *slot = Level {
+                    h,
+                    value: value(r)?,
+                };
             }
             let e = extrapolate(l, self.rule)
                 .map_err(|e| Error::Input(format!("square-cup reference, {q}: {e}")))?;
@@ -236,7 +242,10 @@ mod tests {
                 iterations: 0,
                 increments: 0,
                 cutbacks: 0,
-                values: QUANTITIES.iter().map(|q| (q.to_string(), value(h))).collect(),
+                values: QUANTITIES
+                    .iter()
+                    .map(|q| (q.to_string(), value(h)))
+                    .collect(),
             });
         }
         s
@@ -247,7 +256,11 @@ mod tests {
         let s = stored([[48, 4], [24, 2], [12, 1]], |h| 5.0 + 0.2 * h * h);
         let r = s.extrapolate().unwrap();
         assert!(r.similar);
-        assert!(r.ratios.iter().all(|q| (q - 2.0).abs() < 1e-12), "{:?}", r.ratios);
+        assert!(
+            r.ratios.iter().all(|q| (q - 2.0).abs() < 1e-12),
+            "{:?}",
+            r.ratios
+        );
         for e in r.quantities.values() {
             assert!(e.asymptotic && (e.order - 2.0).abs() < 1e-9 && (e.value - 5.0).abs() < 1e-11);
         }
@@ -281,13 +294,21 @@ mod tests {
                 format!("--set travel={:.1} ", stored.travel_mm),
                 format!("--set step={} ", stored.step_mm),
             ] {
-                assert!(run.command.contains(&part), "{}: {}", run.label(), run.command);
+                assert!(
+                    run.command.contains(&part),
+                    "{}: {}",
+                    run.label(),
+                    run.command
+                );
             }
         }
         let r = stored.extrapolate().unwrap();
         assert_eq!(r.quantities.len(), QUANTITIES.len());
         // The quarter model is symmetric about the diagonal: DX and DY agree to round-off.
-        let (dx, dy) = (&r.quantities["draw_in_dx_mm"], &r.quantities["draw_in_dy_mm"]);
+        let (dx, dy) = (
+            &r.quantities["draw_in_dx_mm"],
+            &r.quantities["draw_in_dy_mm"],
+        );
         assert!((dx.value - dy.value).abs() < 1e-9 * dx.value);
     }
 }

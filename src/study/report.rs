@@ -175,7 +175,11 @@ fn extrapolation_section(o: &mut String, x: &ExtrapolatedReference) {
         "| quantity | {} | observed order | R | verdict | reference | U | U / reference | finest mesh's error |",
         x.sequence.join(" | ")
     );
-    let _ = writeln!(o, "|---|{}---|---|---|---|---|---|---|", "---|".repeat(x.sequence.len()));
+    let _ = writeln!(
+        o,
+        "|---|{}---|---|---|---|---|---|---|",
+        "---|".repeat(x.sequence.len())
+    );
     for (key, e) in &x.quantities {
         let values: Vec<String> = x
             .sequence

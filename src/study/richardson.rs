@@ -133,7 +133,9 @@ pub fn observed_order(fine: Level, medium: Level, coarse: Level) -> Option<f64> 
 /// are not strictly increasing or not finite.
 pub fn extrapolate(levels: [Level; 3], rule: OrderRule) -> Result<Extrapolation, String> {
     let [fine, medium, coarse] = levels;
-    let sizes_ok = levels.iter().all(|l| l.h.is_finite() && l.h > 0.0 && l.value.is_finite());
+    let sizes_ok = levels
+        .iter()
+        .all(|l| l.h.is_finite() && l.h > 0.0 && l.value.is_finite());
     if !(sizes_ok && fine.h < medium.h && medium.h < coarse.h) {
         return Err(format!(
             "a Richardson extrapolation needs three finite values on meshes of strictly growing size, finest first; got h = {}, {}, {}",
@@ -215,7 +217,11 @@ mod tests {
             // Round-off: the differences e21, e32 carry ~1e-16 |f| each, amplified by
             // 1 / (r^p - 1) and 1 / ln r.
             assert!((e.order - p).abs() < 1e-9, "p {} against {p}", e.order);
-            assert!((e.value - f0).abs() < 1e-11 * f0.abs(), "f0 {} against {f0}", e.value);
+            assert!(
+                (e.value - f0).abs() < 1e-11 * f0.abs(),
+                "f0 {} against {f0}",
+                e.value
+            );
             // GCI: 1.25 times the finest mesh's true error.
             let true_error = (c * 1f64.powf(p)).abs();
             assert!((e.uncertainty - 1.25 * true_error).abs() < 1e-9 * true_error);
@@ -231,7 +237,11 @@ mod tests {
             assert!(e.asymptotic, "{}", e.verdict);
             // The bisection stops at 2^-60 of the bracket (4e-17 * 50); round-off dominates.
             assert!((e.order - p).abs() < 1e-9, "p {} against {p}", e.order);
-            assert!((e.value - f0).abs() < 1e-11 * f0.abs(), "f0 {} against {f0}", e.value);
+            assert!(
+                (e.value - f0).abs() < 1e-11 * f0.abs(),
+                "f0 {} against {f0}",
+                e.value
+            );
         }
     }
 
@@ -251,10 +261,18 @@ mod tests {
     fn diverging_and_out_of_band_sequences_are_flagged() {
         let diverging = [(1.0, 1.0), (2.0, 2.0), (4.0, 2.5)].map(|(h, value)| Level { h, value });
         let e = extrapolate(diverging, RULE).unwrap();
-        assert!(!e.asymptotic && e.verdict.contains("not converging"), "{}", e.verdict);
+        assert!(
+            !e.asymptotic && e.verdict.contains("not converging"),
+            "{}",
+            e.verdict
+        );
         // Order 5 (R = 1/32): converging, but far faster than the elements can.
         let steep = extrapolate(manufactured(1.0, 0.01, 5.0, [1.0, 2.0, 4.0]), RULE).unwrap();
-        assert!(!steep.asymptotic && steep.verdict.contains("outside"), "{}", steep.verdict);
+        assert!(
+            !steep.asymptotic && steep.verdict.contains("outside"),
+            "{}",
+            steep.verdict
+        );
         assert!((steep.observed_order.unwrap() - 5.0).abs() < 1e-9);
         assert_eq!(steep.order, 1.0);
     }

@@ -275,7 +275,11 @@ fn extrapolated_reference(opts: &StudyOptions) -> Result<ExtrapolatedReference> 
 }
 
 /// The case's result, every converged point's error measured against `reference`.
-fn scored(mut points: Vec<Point>, reference: ExtrapolatedReference, opts: &StudyOptions) -> Result<CaseResult> {
+fn scored(
+    mut points: Vec<Point>,
+    reference: ExtrapolatedReference,
+    opts: &StudyOptions,
+) -> Result<CaseResult> {
     let values = reference.values();
     for p in points.iter_mut().filter(|p| p.outcome.converged()) {
         if let Some(missing) = QUANTITIES.iter().find(|q| !p.values.contains_key(**q)) {
@@ -384,7 +388,12 @@ mod tests {
             step_mm: 0.5,
         };
         let opts = StudyOptions::new("unused", "test");
-        let err = scored(vec![point], reference, &opts).unwrap_err().to_string();
-        assert!(err.contains("8x8") && err.contains("draw_in_dy_mm"), "{err}");
+        let err = scored(vec![point], reference, &opts)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("8x8") && err.contains("draw_in_dy_mm"),
+            "{err}"
+        );
     }
 }

@@ -456,7 +456,10 @@ pub fn write_case(result: &CaseResult, opts: &StudyOptions) -> Result<()> {
         .extrapolated
         .as_ref()
         .map(|r| (r.worst_relative_uncertainty(), "reference uncertainty"));
-    let hlines: Vec<(f64, &str)> = [Some((0.01, "1 %")), uncertainty].into_iter().flatten().collect();
+    let hlines: Vec<(f64, &str)> = [Some((0.01, "1 %")), uncertainty]
+        .into_iter()
+        .flatten()
+        .collect();
     let svg = log_log(
         &format!("{}: error against wall time", result.title),
         "wall time of the whole run [s]",
