@@ -469,3 +469,45 @@ fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
     assert!(sim.displacements().iter().all(|&u| u == 0.0));
     assert!(sim.history.is_empty());
 }
+
+/// Fixed stepping: each history row counts the cutbacks made before it was reached, so the
+/// rows of a nominal increment add up to its number of halvings (a row's dt is the nominal
+/// one halved that many times so far) and history.csv's column sums to the failed attempts.
+#[test]
+fn fixed_step_cutbacks_are_counted_once() {
+    let script = robust_script("fast_drag.rhai");
+    let sets: Vec<_> = [
+        "radius=0.25",
+        "cells=24",
+        "max_iterations=10",
+        "max_cutbacks=6",
+        "step_control=\"fixed\"",
+    ]
+    .iter()
+    .map(|s| script::parse_override(s).unwrap())
+    .collect();
+    let dir = out_dir("fixed-cutbacks");
+    script::run_file(&script, &sets, &quiet_host(&dir)).unwrap();
+    let time = history_column(&dir, "time");
+    let dt = history_column(&dir, "dt");
+    let cutbacks = history_column(&dir, "cutbacks");
+    // Two nominal increments of 1 (end time 2).
+    let (mut nominal_end, mut halvings) = (1.0, 0.0);
+    for k in 0..time.len() {
+        halvings += cutbacks[k];
+        let expected = 1.0 / 2f64.powf(halvings);
+        assert!(
+            (dt[k] - expected).abs() <= 1e-12,
+            "row {k}: dt {} after {halvings} halvings, expected {expected}",
+            dt[k]
+        );
+        if (time[k] - nominal_end).abs() <= 1e-12 {
+            nominal_end += 1.0;
+            halvings = 0.0;
+        }
+    }
+    let total: f64 = cutbacks.iter().sum();
+    println!("fixed drag: {} rows, {total} cutbacks", time.len());
+    assert!(total >= 1.0, "the fast drag needs cutbacks in two fixed steps");
+    let _ = std::fs::remove_dir_all(&dir);
+}

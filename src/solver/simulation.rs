@@ -328,8 +328,10 @@ impl Simulation {
     }
 
     /// Advances one increment. Fixed stepping: one nominal increment, halved on failure up
-    /// to `max_cutbacks` times (the sub-increments are all in `history`). Adaptive stepping:
-    /// one increment of the size the controller chose (see `step_control`).
+    /// to `max_cutbacks` times (the sub-increments are all in `history`, each counting the
+    /// cutbacks made before it was reached, so that their sum is the run's number of failed
+    /// attempts; the returned report counts the whole nominal increment's). Adaptive
+    /// stepping: one increment of the size the controller chose (see `step_control`).
     pub fn step(&mut self) -> Result<IncrementReport> {
         self.check_interrupt()?;
         if self.is_finished() {
@@ -365,7 +367,7 @@ impl Simulation {
     fn step_fixed(&mut self) -> Result<IncrementReport> {
         let target = (self.time + self.nominal_dt()).min(self.model.settings.end_time);
         let mut dt = target - self.time;
-        let mut cutbacks = 0;
+        let (mut cutbacks, mut recorded) = (0, 0);
         loop {
             let t_new = if dt >= target - self.time {
                 target
@@ -375,12 +377,14 @@ impl Simulation {
             match self.try_increment(t_new) {
                 Ok(trial) => {
                     let mut report = self.accept(t_new, trial);
-                    report.cutbacks = cutbacks;
+                    report.cutbacks = cutbacks - recorded;
+                    recorded = cutbacks;
                     self.history.push(report.clone());
                     if t_new < target {
                         // Finish the nominal increment with the reduced size.
                         continue;
                     }
+                    report.cutbacks = cutbacks;
                     return Ok(report);
                 }
                 Err(err @ Error::Interrupted(_)) => return Err(err),
