@@ -102,6 +102,9 @@ fn case_section(o: &mut String, c: &CaseResult) {
     }
     if let Some(x) = &c.extrapolated {
         extrapolation_section(o, x);
+        if let Some(y) = &c.cross_reference {
+            cross_reference_section(o, x, y);
+        }
     } else if let Some(r) = &c.reference {
         let _ = writeln!(
             o,
@@ -160,7 +163,8 @@ fn quantity_name(key: &str) -> &str {
 fn extrapolation_section(o: &mut String, x: &ExtrapolatedReference) {
     let _ = writeln!(
         o,
-        "**Reference:** Richardson extrapolation over {} ({} mm steps; runs at commit {}). Asymptotic when the convergence ratio R = (f2 - f1) / (f3 - f2) lies in (0, 1) and the observed order in [{}, {}]; then U = {} |f_ext - f1|, else order {} assumed from the two finest meshes and U = {} |f_ext - f1| (Roache's GCI; U is a band around the finest mesh's value that should hold the converged one).\n",
+        "**Reference ({} element):** Richardson extrapolation over {} ({} mm steps; runs at commit {}). Asymptotic when the convergence ratio R = (f2 - f1) / (f3 - f2) lies in (0, 1) and the observed order in [{}, {}]; then U = {} |f_ext - f1|, else order {} assumed from the two finest meshes and U = {} |f_ext - f1| (Roache's GCI; U is a band around the finest mesh's value that should hold the converged one).\n",
+        x.element,
         x.sequence.join(", "),
         x.step_mm,
         x.commit.chars().take(7).collect::<String>(),
@@ -232,6 +236,36 @@ fn extrapolation_section(o: &mut String, x: &ExtrapolatedReference) {
             r.cutbacks,
             error,
             r.command
+        );
+    }
+    o.push('\n');
+}
+
+/// The second element family's extrapolation and, per quantity, whether the two references
+/// agree within the sum of their bands.
+fn cross_reference_section(o: &mut String, x: &ExtrapolatedReference, y: &ExtrapolatedReference) {
+    let _ = writeln!(
+        o,
+        "**Independent check of the reference:** the same cup meshed with another element ({}), whose coarse meshes err on the other side, extrapolated alike. Two sound references differ by no more than the sum of their bands.\n",
+        y.element
+    );
+    extrapolation_section(o, y);
+    let _ = writeln!(
+        o,
+        "| quantity | {} reference | {} reference | difference | sum of the bands | agree |",
+        x.element, y.element
+    );
+    let _ = writeln!(o, "|---|---|---|---|---|---|");
+    for a in super::cup_reference::cross_check(x, y) {
+        let _ = writeln!(
+            o,
+            "| {} | {:.5} | {:.5} | {:.2e} | {:.2e} | {} |",
+            quantity_name(&a.quantity),
+            a.first,
+            a.second,
+            a.relative_difference,
+            a.relative_band,
+            if a.agrees { "yes" } else { "**no**" }
         );
     }
     o.push('\n');

@@ -264,20 +264,31 @@ fn notes(r: &ExtrapolatedReference) -> String {
 
 /// The stored mesh sequence (see `cup_reference::locate`), extrapolated.
 fn extrapolated_reference(opts: &StudyOptions) -> Result<ExtrapolatedReference> {
-    let stored_path = cup_reference::locate(&opts.out)?;
+    stored_reference(opts, cup_reference::STORED_FILE)
+}
+
+fn stored_reference(opts: &StudyOptions, file: &str) -> Result<ExtrapolatedReference> {
+    let stored_path = cup_reference::locate(&opts.out, file)?;
     let reference = cup_reference::load(&stored_path)?.extrapolate()?;
     opts.note(&format!(
-        "  reference: Richardson extrapolation over {} from {}",
+        "  reference ({}): Richardson extrapolation over {} from {}",
+        reference.element,
         reference.sequence.join(", "),
         stored_path.display()
     ));
     Ok(reference)
 }
 
+/// The solid-shell sequence's extrapolation, the independent check of the reference.
+fn cross_reference(opts: &StudyOptions) -> Result<ExtrapolatedReference> {
+    stored_reference(opts, cup_reference::SOLID_SHELL_FILE)
+}
+
 /// The case's result, every converged point's error measured against `reference`.
 fn scored(
     mut points: Vec<Point>,
     reference: ExtrapolatedReference,
+    cross_reference: Option<ExtrapolatedReference>,
     opts: &StudyOptions,
 ) -> Result<CaseResult> {
     let values = reference.values();
@@ -311,6 +322,7 @@ fn scored(
         points,
         command: opts.command.clone(),
         extrapolated: Some(reference),
+        cross_reference,
     })
 }
 
@@ -324,7 +336,10 @@ pub fn run(opts: &StudyOptions) -> Result<()> {
     let no_error = |_: &Values, _: Option<&Values>| f64::NAN;
     let (_, points) = run_families(&families(), None, &measure, &no_error, Some(opts))?;
     let _ = std::fs::remove_dir_all(&scratch);
-    write_case(&scored(points, reference, opts)?, opts)
+    write_case(
+        &scored(points, reference, Some(cross_reference(opts)?), opts)?,
+        opts,
+    )
 }
 
 /// Measures the runs of an existing `square_cup/results.json` against the stored reference
@@ -335,7 +350,7 @@ pub fn rescore(opts: &StudyOptions) -> Result<()> {
     let old: CaseResult = serde_json::from_str(&text)
         .map_err(|e| Error::io(&path, format!("not a study result: {e}")))?;
     let reference = extrapolated_reference(opts)?;
-    let mut result = scored(old.points, reference, opts)?;
+    let mut result = scored(old.points, reference, Some(cross_reference(opts)?), opts)?;
     result.command = old.command;
     write_case(&result, opts)
 }
@@ -374,6 +389,7 @@ mod tests {
             error: None,
         };
         let reference = ExtrapolatedReference {
+            element: cup_reference::HEXAHEDRON.into(),
             sequence: Vec::new(),
             ratios: [2.0, 2.0],
             similar: true,
@@ -388,7 +404,7 @@ mod tests {
             step_mm: 0.5,
         };
         let opts = StudyOptions::new("unused", "test");
-        let err = scored(vec![point], reference, &opts)
+        let err = scored(vec![point], reference, None, &opts)
             .unwrap_err()
             .to_string();
         assert!(

@@ -77,6 +77,10 @@ pub struct CaseResult {
     /// (the square cup's).
     #[serde(default)]
     pub extrapolated: Option<ExtrapolatedReference>,
+    /// A second extrapolated reference, from another element family, that checks the
+    /// first (the square cup's solid-shell sequence).
+    #[serde(default)]
+    pub cross_reference: Option<ExtrapolatedReference>,
 }
 
 /// Runs shorter than this many seconds are repeated and timed by their mean.
@@ -397,6 +401,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
             points: run_families(&hertz_families(), None, &hertz_measure, &hertz_error, Some(opts))?.1,
             command: opts.command.clone(),
             extrapolated: None,
+            cross_reference: None,
         },
         "friction_work" => CaseResult {
             name: name.into(),
@@ -407,6 +412,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
             points: run_families(&friction_work_families(), None, &friction_work_measure, &friction_work_error, Some(opts))?.1,
             command: opts.command.clone(),
             extrapolated: None,
+            cross_reference: None,
         },
         "cylinder_drag" => {
             let reference = drag_reference();
@@ -421,6 +427,7 @@ pub fn run(name: &str, opts: &StudyOptions) -> Result<()> {
                 points,
                 command: opts.command.clone(),
             extrapolated: None,
+            cross_reference: None,
             }
         }
         other => return Err(Error::Input(format!("no work-precision case named '{other}'"))),
