@@ -508,6 +508,9 @@ fn fixed_step_cutbacks_are_counted_once() {
     }
     let total: f64 = cutbacks.iter().sum();
     println!("fixed drag: {} rows, {total} cutbacks", time.len());
-    assert!(total >= 1.0, "the fast drag needs cutbacks in two fixed steps");
+    assert!(
+        total >= 1.0,
+        "the fast drag needs cutbacks in two fixed steps"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
