@@ -278,6 +278,11 @@ pub struct Evaluation {
     /// Force of the supports on the body at prescribed displacement components (zero
     /// elsewhere): f_int - f_ext + contact at those rows.
     pub support_forces: Vec<f64>,
+    /// The assembled element stiffness alone (before loads, contact and unit rows), kept
+    /// when the context asks for it ([`IncrementContext::keep_element_jacobian`]) so that
+    /// the contact part can be linearised again at the same unknowns without running the
+    /// elements again ([`IncrementContext::relinearised`]).
+    pub element_jacobian: Option<Vec<f64>>,
 }
 
 impl Evaluation {
@@ -303,6 +308,18 @@ pub struct IncrementContext<'a> {
     pub forced: Option<Vec<Vec<Option<crate::contact::ContactStatus>>>>,
     /// The solid-shell's enhanced parameters of the last evaluation, its next start.
     pub warm_start: crate::element::solid_shell::WarmStart,
+    /// Whether full evaluations keep their element stiffness (status prediction re-solves
+    /// with other contact statuses at the same unknowns).
+    pub keep_element_jacobian: bool,
+}
+
+/// What the elements give at some unknowns: the part of an evaluation that does not depend
+/// on the contact statuses.
+struct ElementPart {
+    /// Assembled element stiffness (no values for a residual-only evaluation).
+    jacobian: SparseMatrix,
+    f_int: Vec<f64>,
+    trial_points: Vec<PointState>,
 }
 
 impl IncrementContext<'_> {
@@ -358,6 +375,7 @@ impl IncrementContext<'_> {
         )?;
         let mut jac = SparseMatrix::zeros(self.pattern.clone());
         slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
+        let element_jacobian = self.keep_element_jacobian.then(|| jac.values.clone());
         times.elements += t0.elapsed().as_secs_f64();
         // The follower loads' stiffness, in `evaluate_with`'s order (their forces are
         // already in `eval`'s residual; the scratch copy is discarded).
@@ -387,8 +405,36 @@ impl IncrementContext<'_> {
         Ok(Evaluation {
             jacobian: jac,
             trial_points,
+            element_jacobian,
             ..eval
         })
+    }
+
+    /// The full evaluation at the unknowns `x` of the full evaluation `eval`, with the
+    /// contact part linearised again (for other imposed statuses, `forced`), reusing
+    /// `eval`'s element part: the element kernel does not run. Equal, bit for bit, to
+    /// [`Self::evaluate`] at `x` with the same `forced` (the same additions in the same
+    /// order). Without a kept element stiffness (`keep_element_jacobian` off, or an `eval`
+    /// with no Jacobian), a full evaluation.
+    pub fn relinearised(
+        &self,
+        x: &[f64],
+        eval: &Evaluation,
+        times: &mut PhaseTimes,
+    ) -> Result<Evaluation> {
+        let Some(values) = eval.element_jacobian.as_ref() else {
+            return self.evaluate(x, times);
+        };
+        times.full_evaluations += 1;
+        let part = ElementPart {
+            jacobian: SparseMatrix {
+                pattern: self.pattern.clone(),
+                values: values.clone(),
+            },
+            f_int: eval.f_int.clone(),
+            trial_points: eval.trial_points.clone(),
+        };
+        self.with_contact(x, part, times, true)
     }
 
     /// The multiplier components `k` of a pair whose equation becomes `lambda_k = 0`: a
@@ -434,9 +480,25 @@ impl IncrementContext<'_> {
         times: &mut PhaseTimes,
         with_jacobian: bool,
     ) -> Result<Evaluation> {
+        if with_jacobian {
+            times.full_evaluations += 1;
+        } else {
+            times.residual_evaluations += 1;
+        }
+        let part = self.element_part(x, times, with_jacobian)?;
+        self.with_contact(x, part, times, with_jacobian)
+    }
+
+    /// The elements at `x`: their assembled stiffness (when `with_jacobian`, or a
+    /// force-controlled tool needs a matrix to write into), internal forces and trial
+    /// point states.
+    fn element_part(
+        &self,
+        x: &[f64],
+        times: &mut PhaseTimes,
+        with_jacobian: bool,
+    ) -> Result<ElementPart> {
         let model = self.model;
-        let n = self.dofs.n_dofs;
-        let mut residual = vec![0.0; n];
         let mut f_int = vec![0.0; 3 * self.dofs.n_nodes];
         // Force-controlled tools add their rows through `SparseMatrix::add` (outside this
         // module), so a residual-only evaluation still gives them a matrix to write into.
@@ -451,12 +513,6 @@ impl IncrementContext<'_> {
         };
         let mut trial_points = self.committed_points.to_vec();
         self.warm_start.seed(&mut trial_points);
-
-        if with_jacobian {
-            times.full_evaluations += 1;
-        } else {
-            times.residual_evaluations += 1;
-        }
         let t0 = Instant::now();
         let threads = element_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);
@@ -479,6 +535,33 @@ impl IncrementContext<'_> {
             slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
         }
         times.elements += t0.elapsed().as_secs_f64();
+        Ok(ElementPart {
+            jacobian: jac,
+            f_int,
+            trial_points,
+        })
+    }
+
+    /// An evaluation from its element part: loads, contact, force control, prescribed
+    /// components.
+    fn with_contact(
+        &self,
+        x: &[f64],
+        part: ElementPart,
+        times: &mut PhaseTimes,
+        with_jacobian: bool,
+    ) -> Result<Evaluation> {
+        let model = self.model;
+        let n = self.dofs.n_dofs;
+        let mut residual = vec![0.0; n];
+        let ElementPart {
+            jacobian: mut jac,
+            f_int,
+            trial_points,
+        } = part;
+        let element_jacobian =
+            (with_jacobian && self.keep_element_jacobian).then(|| jac.values.clone());
+        let slots = self.dofs.slots(model, &self.pattern);
 
         let mut f_ext = model.external_forces(self.time);
         for load in &model.follower_loads {
@@ -611,6 +694,7 @@ impl IncrementContext<'_> {
             f_int,
             f_ext,
             support_forces,
+            element_jacobian,
         })
     }
 }
@@ -783,7 +867,7 @@ mod tests {
                         .collect()
                 })
                 .collect();
-            let ctx = IncrementContext {
+            let mut ctx = IncrementContext {
                 model: &model,
                 dofs: &dofs,
                 pattern,
@@ -795,6 +879,7 @@ mod tests {
                 is_fixed: &is_fixed,
                 forced: None,
                 warm_start: Default::default(),
+                keep_element_jacobian: true,
             };
             let mut times = PhaseTimes::default();
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -847,6 +932,22 @@ mod tests {
                     .map(|(r, _)| r.status)
                     .collect::<Vec<_>>()
             );
+            // The contact part linearised again on other statuses, the element part kept:
+            // the full evaluation with those statuses imposed, bit for bit.
+            assert!(full.element_jacobian.is_some() && residual_only.element_jacobian.is_none());
+            let flipped = |s: &ContactStatus| match s {
+                ContactStatus::Gap => Some(ContactStatus::Slip),
+                ContactStatus::Stick => Some(ContactStatus::Gap),
+                ContactStatus::Slip => Some(ContactStatus::Stick),
+            };
+            ctx.forced = Some(vec![statuses.iter().map(flipped).collect()]);
+            let again = ctx.relinearised(&x, &full, &mut times).unwrap();
+            let imposed = ctx.evaluate(&x, &mut times).unwrap();
+            assert_ne!(bits(&again.jacobian.values), bits(&full.jacobian.values));
+            assert_eq!(bits(&again.jacobian.values), bits(&imposed.jacobian.values));
+            assert_eq!(bits(&again.residual), bits(&imposed.residual));
+            assert_eq!(bits(&again.support_forces), bits(&imposed.support_forces));
+            assert_eq!(again.trial_points, imposed.trial_points);
         }
     }
 }

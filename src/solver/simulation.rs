@@ -297,6 +297,7 @@ impl Simulation {
             is_fixed: &self.is_fixed,
             forced: None,
             warm_start: Default::default(),
+            keep_element_jacobian: self.model.settings.status_prediction > 0,
         }
     }
 

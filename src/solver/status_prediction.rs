@@ -18,8 +18,9 @@
 //! branch the node is heading into. Only the step changes: the line search and the
 //! convergence test use the exact law, so the converged answer is the same.
 //!
-//! Cost per re-solve: one evaluation and one linear solve; the prediction itself is O(1)
-//! per contact pair.
+//! Cost per re-solve: the contact part of one evaluation (the element part at `x` is kept
+//! from the step's own evaluation, [`IncrementContext::relinearised`]) and one linear
+//! solve; the prediction itself is O(1) per contact pair.
 
 use super::assembly::{DofMap, Evaluation, IncrementContext, PhaseTimes};
 use super::linear::LinearSolver;
@@ -110,7 +111,7 @@ impl Simulation {
                 })
                 .collect();
             ctx.forced = Some(forced);
-            let held = ctx.evaluate(x, times);
+            let held = ctx.relinearised(x, eval, times);
             ctx.forced = None;
             // A predicted set can leave a body held by nothing (every node of a
             // force-controlled holder predicted to lift off): a singular system, the plain
