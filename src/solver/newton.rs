@@ -221,8 +221,16 @@ impl Simulation {
         Ok(())
     }
 
-    pub(super) fn newton(&self, t_new: f64, linear: &mut dyn LinearSolver) -> Result<Trial> {
-        let settings = self.model.settings.clone();
+    /// Newton's method for the increment to `t_new`, with `prediction` status-prediction
+    /// rounds per step (`Settings::status_prediction`, or 0 for the plain step).
+    pub(super) fn newton(
+        &self,
+        t_new: f64,
+        linear: &mut dyn LinearSolver,
+        prediction: usize,
+    ) -> Result<Trial> {
+        let mut settings = self.model.settings.clone();
+        settings.status_prediction = prediction;
         let step = &settings.stepping;
         let mut x = self.x.clone();
         let frozen = match settings.contact.frame {
@@ -398,7 +406,6 @@ impl Simulation {
                     linear,
                     &mut times,
                     settings.status_prediction,
-                    (merit, &weights),
                 )?
             } else {
                 dx
