@@ -76,6 +76,7 @@ impl DofMap {
             Arc::new(AssemblySlots::new(
                 model,
                 &self.lambda_offset,
+                &self.tool_offset,
                 pattern.clone(),
             ))
         };
@@ -392,7 +393,15 @@ impl IncrementContext<'_> {
             for (k, &node) in contact.candidates.iter().enumerate() {
                 let result = &eval.nodal[c][k].0;
                 let lam_dof = self.dofs.lambda_offset[c].map(|off| off + 3 * k);
-                self.add_pair_jacobian(&mut jac, &slots.contact[c][k], result, c, node, lam_dof);
+                let fc_column = slots.force_control[c].as_ref().map(|f| &f.column[k]);
+                self.add_pair_jacobian(
+                    &mut jac,
+                    &slots.contact[c][k],
+                    fc_column,
+                    result,
+                    c,
+                    lam_dof,
+                );
                 if let Some(l) = lam_dof {
                     for i in self.multiplier_unit_rows(result, node) {
                         unit[l + i] = true;
@@ -449,28 +458,31 @@ impl IncrementContext<'_> {
         (0..3).filter(move |&k| stick && self.is_fixed[3 * node + k])
     }
 
-    /// Adds one contact pair's blocks (operator output `result` of candidate `node` of
-    /// tool `c`, multipliers at `lam_dof`) to the Jacobian at their slots.
+    /// Adds one contact pair's blocks (operator output `result` of a candidate of
+    /// tool `c`, multipliers at `lam_dof`, offset column `fc_column` when force-controlled)
+    /// to the Jacobian at their slots.
     fn add_pair_jacobian(
         &self,
         jac: &mut SparseMatrix,
         pair_slots: &super::slots::ContactSlots,
+        fc_column: Option<&[usize; 6]>,
         result: &NodalContact,
         c: usize,
-        node: usize,
         lam_dof: Option<usize>,
     ) {
         for (ij, &slot) in pair_slots[0].iter().enumerate() {
             jac.values[slot] += result.equi_x[(ij / 3, ij % 3)];
         }
-        if let Some(l) = lam_dof {
+        if lam_dof.is_some() {
             for ij in 0..9 {
                 let (i, j) = (ij / 3, ij % 3);
                 jac.values[pair_slots[1][ij]] += result.equi_lambda[(i, j)];
                 jac.values[pair_slots[2][ij]] += result.suppl_x[(i, j)];
                 jac.values[pair_slots[3][ij]] += result.suppl_lambda[(i, j)];
             }
-            force_control::add_node_column(jac, self.model, self.dofs, c, node, l, result);
+            if let Some(column) = fc_column {
+                force_control::add_node_column(&mut jac.values, self.model, c, column, result);
+            }
         }
     }
 
@@ -650,7 +662,8 @@ impl IncrementContext<'_> {
                     }
                 }
                 if with_jacobian {
-                    self.add_pair_jacobian(&mut jac, pair_slots, &result, c, node, lam_dof);
+                    let fc_column = slots.force_control[c].as_ref().map(|f| &f.column[k]);
+                    self.add_pair_jacobian(&mut jac, pair_slots, fc_column, &result, c, lam_dof);
                 }
                 list.push((result, proj));
             }
@@ -662,6 +675,7 @@ impl IncrementContext<'_> {
             self.time,
             x,
             &nodal,
+            &slots.force_control,
             &mut residual,
             &mut jac,
         )?;

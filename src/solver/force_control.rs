@@ -38,6 +38,7 @@
 
 use super::assembly::DofMap;
 use super::model::Model;
+use super::slots::ForceControlSlots;
 use super::sparse::SparseMatrix;
 use crate::contact::{Enforcement, NodalContact};
 use crate::geometry::{Projection, Vec3};
@@ -121,24 +122,23 @@ pub fn pattern_entries(model: &Model, dofs: &DofMap, entries: &mut Vec<(usize, u
     }
 }
 
-/// Adds the `s` column of one candidate node (node `node`, multiplier block at `l`).
+/// Adds the `s` column of one candidate of force-controlled tool `c` at its precomputed
+/// positions `column` (see `ForceControlSlots`): `values[column[i]] += -(∂r/∂x · axis)_i`.
 pub fn add_node_column(
-    jac: &mut SparseMatrix,
+    values: &mut [f64],
     model: &Model,
-    dofs: &DofMap,
     c: usize,
-    node: usize,
-    l: usize,
+    column: &[usize; 6],
     result: &NodalContact,
 ) {
-    let (Some(s), Some(fc)) = (dofs.tool_offset[c], &model.contacts[c].tool.force_control) else {
+    let Some(fc) = &model.contacts[c].tool.force_control else {
         return;
     };
     let equi = -(result.equi_x * fc.axis);
     let suppl = -(result.suppl_x * fc.axis);
     for i in 0..3 {
-        jac.add(3 * node + i, s, equi[i]);
-        jac.add(l + i, s, suppl[i]);
+        values[column[i]] += equi[i];
+        values[column[3 + i]] += suppl[i];
     }
 }
 
@@ -177,21 +177,25 @@ pub fn row_scale(model: &Model, c: usize) -> f64 {
 }
 
 /// Adds the force equation of every force-controlled tool (or its approach equation when
-/// the tool touches nothing) at time `time`. `nodal` is the evaluation's per-node output.
+/// the tool touches nothing) at time `time`. `nodal` is the evaluation's per-node output;
+/// the Jacobian entries go to their precomputed positions `slots` (per tool).
+#[allow(clippy::too_many_arguments)]
 pub fn add_force_rows(
     model: &Model,
     dofs: &DofMap,
     time: f64,
     x: &[f64],
     nodal: &[Vec<(NodalContact, Option<Projection>)>],
+    slots: &[Option<ForceControlSlots>],
     residual: &mut [f64],
     jac: &mut SparseMatrix,
 ) -> Result<()> {
     for (c, contact) in model.contacts.iter().enumerate() {
-        let (Some(s), Some(off), Some(fc)) = (
+        let (Some(s), Some(off), Some(fc), Some(fs)) = (
             dofs.tool_offset[c],
             dofs.lambda_offset[c],
             &contact.tool.force_control,
+            &slots[c],
         ) else {
             continue;
         };
@@ -203,7 +207,7 @@ pub fn add_force_rows(
                 let lambda = Vec3::new(x[l], x[l + 1], x[l + 2]);
                 pushed -= fc.axis.dot(&lambda);
                 for j in 0..3 {
-                    jac.add(s, l + j, -fc.axis[j] / r_s);
+                    jac.values[fs.row[k][j]] += -fc.axis[j] / r_s;
                 }
             }
             residual[s] = (pushed - fc.force.value(time)) / r_s;
@@ -215,7 +219,7 @@ pub fn add_force_rows(
                 ))
             })?;
             residual[s] = -travel;
-            jac.add(s, s, 1.0);
+            jac.values[fs.diagonal] += 1.0;
         }
     }
     Ok(())

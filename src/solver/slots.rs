@@ -25,6 +25,12 @@
 //! Per (tool, candidate) pair the 36 positions of its four `3 x 3` blocks: node-node,
 //! node-multiplier, multiplier-node, multiplier-multiplier (the last three only under the
 //! augmented Lagrangian).
+//!
+//! # Force-controlled tools
+//!
+//! Per force-controlled tool (offset unknown `s`) the positions of its offset column (per
+//! candidate: three equilibrium rows, three multiplier rows), its force row (per candidate:
+//! three multiplier columns) and its diagonal `(s, s)` (the approach equation).
 
 use super::model::Model;
 use super::sparse::SparsePattern;
@@ -37,6 +43,17 @@ pub const ELEMENT_ENTRIES: usize = DOFS * DOFS;
 /// `[node-node, node-lambda, lambda-node, lambda-lambda]`.
 pub type ContactSlots = [[usize; 9]; 4];
 
+/// Positions of one force-controlled tool's entries; see the module docs.
+#[derive(Debug)]
+pub struct ForceControlSlots {
+    /// Per candidate: `(3 node + i, s)` for `i < 3`, then `(l + i, s)` (multipliers at `l`).
+    pub column: Vec<[usize; 6]>,
+    /// Per candidate: `(s, l + j)` for `j < 3`.
+    pub row: Vec<[usize; 3]>,
+    /// `(s, s)`.
+    pub diagonal: usize,
+}
+
 /// Value positions of the element and contact entries of one pattern; see the module docs.
 #[derive(Debug)]
 pub struct AssemblySlots {
@@ -46,15 +63,19 @@ pub struct AssemblySlots {
     gather_src: Vec<u32>,
     /// Per tool, per candidate.
     pub contact: Vec<Vec<ContactSlots>>,
+    /// Per tool: `Some` for a force-controlled tool.
+    pub force_control: Vec<Option<ForceControlSlots>>,
 }
 
 impl AssemblySlots {
     /// Builds the slots of `model`'s elements and contact pairs in `pattern` (which must
     /// contain them: it is built from the same model by `DofMap::pattern`), with the first
-    /// multiplier dof of each tool in `lambda_offset` (None: penalty).
+    /// multiplier dof of each tool in `lambda_offset` (None: penalty) and the offset unknown
+    /// of each force-controlled tool in `tool_offset`.
     pub fn new(
         model: &Model,
         lambda_offset: &[Option<usize>],
+        tool_offset: &[Option<usize>],
         pattern: std::sync::Arc<SparsePattern>,
     ) -> Self {
         let position = |r: usize, c: usize| {
@@ -119,11 +140,43 @@ impl AssemblySlots {
                     .collect()
             })
             .collect();
+        let force_control = model
+            .contacts
+            .iter()
+            .enumerate()
+            .map(|(c, contact)| {
+                let (s, off) = (tool_offset[c]?, lambda_offset[c]?);
+                let column = contact
+                    .candidates
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &node)| {
+                        let l = off + 3 * k;
+                        std::array::from_fn(|i| {
+                            if i < 3 {
+                                position(3 * node + i, s)
+                            } else {
+                                position(l + i - 3, s)
+                            }
+                        })
+                    })
+                    .collect();
+                let row = (0..contact.candidates.len())
+                    .map(|k| std::array::from_fn(|j| position(s, off + 3 * k + j)))
+                    .collect();
+                Some(ForceControlSlots {
+                    column,
+                    row,
+                    diagonal: position(s, s),
+                })
+            })
+            .collect();
         AssemblySlots {
             pattern,
             gather_ptr,
             gather_src,
             contact,
+            force_control,
         }
     }
 
@@ -191,7 +244,12 @@ mod tests {
         let model = Model::new(mesh, Arc::new(LinearElastic::new(1.0, 0.3).unwrap())).unwrap();
         let dofs = DofMap::new(&model);
         let pattern = Arc::new(dofs.pattern(&model));
-        let slots = AssemblySlots::new(&model, &dofs.lambda_offset, pattern.clone());
+        let slots = AssemblySlots::new(
+            &model,
+            &dofs.lambda_offset,
+            &dofs.tool_offset,
+            pattern.clone(),
+        );
         assert!(slots.indexes(&pattern));
         assert!(!slots.indexes(&Arc::new((*pattern).clone())));
         let n_elem = model.mesh.hexes.len();
