@@ -86,6 +86,7 @@ impl Simulation {
     /// did not: without it, the solid-shell cup took 6.0 s instead of 22.9 s
     /// (BENCHMARKS.md). Where a re-solved step leads far off, the increment fails and is
     /// tried again without prediction (`Simulation::try_increment`).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn status_consistent_step(
         &self,
         ctx: &mut IncrementContext<'_>,
