@@ -222,15 +222,18 @@ impl Simulation {
     }
 
     /// Newton's method for the increment to `t_new`, with `prediction` status-prediction
-    /// rounds per step (`Settings::status_prediction`, or 0 for the plain step).
+    /// rounds per step (`Settings::status_prediction`, or 0 for the plain step) and at most
+    /// `max_iterations` iterations.
     pub(super) fn newton(
         &self,
         t_new: f64,
         linear: &mut dyn LinearSolver,
         prediction: usize,
+        max_iterations: usize,
     ) -> Result<Trial> {
         let mut settings = self.model.settings.clone();
         settings.status_prediction = prediction;
+        settings.max_iterations = max_iterations;
         let step = &settings.stepping;
         let mut x = self.x.clone();
         let frozen = match settings.contact.frame {

@@ -57,6 +57,11 @@ pub struct IncrementReport {
 }
 
 /// Failures after which a smaller increment may succeed.
+/// Newton iterations of the plain retry of an increment that failed with status
+/// prediction (the plain retries that converged on the 25 x 25 x 1 paper cup took at most
+/// 15).
+const PLAIN_RETRY_ITERATIONS: usize = 20;
+
 fn retryable(err: &Error) -> bool {
     matches!(err, Error::NoConvergence(_) | Error::LinearSolver(_))
 }
@@ -565,14 +570,17 @@ impl Simulation {
         // The factorization cache lives outside `self` while the context borrows it.
         let mut linear = std::mem::take(&mut self.linear);
         let prediction = self.model.settings.status_prediction;
-        let mut outcome = self.newton(t_new, &mut linear, prediction);
+        let budget = self.model.settings.max_iterations;
+        let mut outcome = self.newton(t_new, &mut linear, prediction, budget);
         // A re-solved step can lead far off where many nodes change status at once (no
         // merit check guards it, see `status_prediction`), and the increment then fails
         // where the plain Newton would not: it is tried once more, plainly, before any
         // cutback (25 x 25 x 1 paper cup to 30 mm: 9 cutbacks and 56 s without the retry,
-        // none and 45 s with it; BENCHMARKS.md).
+        // none and 45 s with it; BENCHMARKS.md). With a short budget: where the plain
+        // Newton cannot converge either (it cycles on the solid-shell cup), a retry with
+        // the whole budget cost more than the cutback it was meant to avoid.
         if prediction > 0 && matches!(&outcome, Err(e) if retryable(e)) {
-            outcome = self.newton(t_new, &mut linear, 0);
+            outcome = self.newton(t_new, &mut linear, 0, budget.min(PLAIN_RETRY_ITERATIONS));
         }
         self.linear = linear;
         outcome
