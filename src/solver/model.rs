@@ -45,9 +45,11 @@ pub struct ToolContact {
 }
 
 /// Status-prediction re-solves per Newton step by default: off. 8 rounds more than halve
-/// the iterations of the 25 x 25 x 1 square cup, but make the path depend on round-off
-/// (the condensed and the mixed system, or two factorizations, then take different
-/// iterations in the first increment): not yet the default (docs/convergence.md).
+/// the iterations of the 25 x 25 x 1 square cup and meet issue 14's cup targets under the
+/// default budget, but the path then depends on round-off, and a frictional first contact
+/// can have several converged states (the cylindrical cup's first increment: 1,782.5 N
+/// plain, 1,674.7 N with prediction, both to the Newton tolerances), so which one a run
+/// finds would depend on the factorization (docs/convergence.md).
 pub const DEFAULT_STATUS_PREDICTION: usize = 0;
 
 /// Newton and stepping settings.
