@@ -194,11 +194,12 @@ fn history(out: &Path) -> Vec<(usize, Vec<f64>)> {
 const PLAIN_NEWTON: &str = "status_prediction: 0,";
 
 /// The default factorization (LU without pivoting on the symmetric structure) and faer's
-/// pivoting LU run the same cup (Newton steps not re-solved, [`PLAIN_NEWTON`]): the same Newton iterations in every increment, forces and
-/// draw-in equal to 1e-7 of their size. Why 1e-7: the two factorizations differ by
-/// round-off only, but each increment's answer is fixed only to the Newton tolerance (a
-/// force residual of 1e-9 of the reference force), and the multipliers amplify that by
-/// the system's conditioning: measured on the benchmark variant, 1.0e-8 of the largest
+/// pivoting LU run the same cup (Newton steps not re-solved, [`PLAIN_NEWTON`]): the same
+/// Newton iterations in every increment, forces and draw-in equal to 1e-7 of their size.
+/// Why 1e-7: the two factorizations differ by round-off only, but each increment's answer
+/// is fixed only to the Newton tolerance (a force residual of 1e-9 of the reference
+/// force), and the multipliers amplify that by the system's conditioning: measured on the
+/// benchmark variant, 1.0e-8 of the largest
 /// force in increment 1 (first contact of the flat blank, the last residual just under the
 /// tolerance), 1.1e-9 in increment 2, below 3e-11 after. On the displacement-only system
 /// (both pairs of the top-face nodes eliminated) 5.1e-9, 3.0e-10, then below 1.3e-11; the

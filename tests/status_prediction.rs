@@ -121,7 +121,7 @@ fn status_prediction_keeps_the_cup_and_shortens_newton() {
 /// travel) drove re-solved steps to 1e3 to 1e15 times the plain step, each round
 /// predicting from the last; every attempt then inverted elements and the increment was
 /// halved four times (measured before the limit). With the limit it is halved once: the
-/// first attempt still fails (re-solves within 100 times the plain step that lead off),
+/// first attempt still fails (re-solves within 1000 times the plain step that lead off),
 /// the plain retry too (the plain Newton needs 43 iterations here), and 0.25 mm converges.
 /// The bound asserted is that one halving.
 #[test]

@@ -527,6 +527,7 @@ fn yield_changes(
     changes
 }
 
-fn norm(v: &[f64]) -> f64 {
+/// Euclidean norm.
+pub(super) fn norm(v: &[f64]) -> f64 {
     v.iter().map(|a| a * a).sum::<f64>().sqrt()
 }

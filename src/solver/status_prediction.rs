@@ -25,6 +25,7 @@
 use super::assembly::{DofMap, Evaluation, IncrementContext, PhaseTimes};
 use super::linear::LinearSolver;
 use super::model::Model;
+use super::newton::norm;
 use super::simulation::Simulation;
 use crate::contact::ContactStatus;
 use crate::geometry::Vec3;
@@ -142,8 +143,4 @@ impl Simulation {
         }
         Ok(step)
     }
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|a| a * a).sum::<f64>().sqrt()
 }
