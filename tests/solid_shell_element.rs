@@ -502,3 +502,103 @@ fn tuned_kernel_equals_the_original() {
         }
     }
 }
+
+/// The local EAS iteration where full Newton steps fail: a virgin flange element of the
+/// square cup (3 x 3 x 0.81 mm, NUMISHEET'93 aluminium, von Mises with Swift hardening) at
+/// the nodal displacements of a global iterate that the solid-shell cup (benchmark variant)
+/// met at the flange rim, about 0.7 % in-plane strain and shear: plastic from the elastic
+/// state, where the stress-strain kink (slope 71,000 -> 2,860 MPa) throws the full-step
+/// local Newton (the reference kernel's) around until it gives up. The element converges
+/// (halved steps after the full ones fail; six Newton steps), and to the same solution from
+/// other starts, force and tangent to 1e-10; its tangent is the derivative of its force
+/// (central differences, as `tangent_equals_central_differences`). (Full steps fail here
+/// even from close by, along a homotopy in the displacements: at the solution some points
+/// sit at the elastic-plastic switch, and full steps jump across it in a 2-cycle.)
+#[test]
+fn halved_local_steps_converge_where_full_steps_fail() {
+    let x: [Vec3; 8] = std::array::from_fn(|a| {
+        let c = HEX_CORNERS[a];
+        Vec3::new(
+            72.0 + 1.5 * (c[0] + 1.0),
+            15.0 + 1.5 * (c[1] + 1.0),
+            0.405 * (c[2] + 1.0),
+        )
+    });
+    // Corner order of HEX_CORNERS: (x, y, z) = (-,-,-), (+,-,-), (+,+,-), (-,+,-), then z +.
+    let u = [
+        Vec3::new(0.00898, 0.05158, -0.00132),
+        Vec3::new(0.01079, 0.02855, 0.00066),
+        Vec3::new(0.01832, 0.03418, -0.00017),
+        Vec3::new(0.01562, 0.03012, -0.00048),
+        Vec3::new(0.00865, 0.05159, 0.00049),
+        Vec3::new(0.01069, 0.02859, 0.00004),
+        Vec3::new(0.01816, 0.03423, 0.00036),
+        Vec3::new(0.01563, 0.03007, 0.00006),
+    ];
+    let m = ElastoPlastic::new(
+        LinearElastic::new(71000.0, 0.33).unwrap(),
+        Hill48::von_mises(),
+        Hardening::swift(576.0, 0.01658, 0.36).unwrap(),
+    );
+    let el = shell(true);
+    let virgin = vec![PointState::default(); el.point_count()];
+    let relative = |a: &[f64], b: &[f64]| {
+        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
+            / scale
+    };
+    let (mut f_ref, mut k_ref) = (vec![0.0; 24], vec![0.0; 576]);
+    let full_steps = tribo::element::solid_shell_reference::evaluate_into(
+        &el,
+        &x,
+        &u,
+        &virgin,
+        &mut virgin.clone(),
+        &m,
+        &mut f_ref,
+        Some(&mut k_ref),
+    );
+    println!("full-step local Newton: {full_steps:?}");
+    assert!(full_steps.is_err(), "the case no longer needs halved steps");
+    let (f, k, trial) = evaluate(&el, &x, &u, &virgin, &m);
+    assert!(trial.iter().any(|p| p.eq_plastic_strain > 1e-3));
+    // The same solution from other starts: along a homotopy (the displacements scaled by
+    // 1/8, ..., 1, each solve started from the previous one's parameters) and from the
+    // converged parameters perturbed at random by up to 0.01 (twice their size).
+    let solve_from = |u: &[Vec3; 8], start: &[f64; 6]| {
+        let mut trial = virgin.clone();
+        for t in trial.iter_mut() {
+            t.enhanced = *start;
+        }
+        let (mut f, mut k) = (vec![0.0; 24], vec![0.0; 576]);
+        el.evaluate_into(&x, u, &virgin, &mut trial, &m, &mut f, Some(&mut k))
+            .unwrap();
+        (f, k, trial[0].enhanced)
+    };
+    let mut starts = Vec::new();
+    let mut start = [0.0; 6];
+    for step in 1..=8 {
+        let scaled: [Vec3; 8] = std::array::from_fn(|a| u[a] * (step as f64 / 8.0));
+        start = solve_from(&scaled, &start).2;
+    }
+    starts.push(start);
+    let mut rng = Lcg(5);
+    for _ in 0..10 {
+        starts.push(std::array::from_fn(|i| {
+            trial[0].enhanced[i] + 0.01 * rng.next()
+        }));
+    }
+    let mut worst = 0.0f64;
+    for start in &starts {
+        let (f_s, k_s, _) = solve_from(&u, start);
+        worst = worst
+            .max(relative(&f_s, f.as_slice()))
+            .max(relative(&k_s, k.as_slice()));
+    }
+    let fd = fd_error(&el, &x, &u, &virgin, &m);
+    println!("other starts: force and tangent within {worst:.1e}; central differences {fd:.1e}");
+    assert!(worst < 1e-10, "{worst:e}");
+    assert!(fd < 1e-6, "{fd:e}");
+}

@@ -53,7 +53,10 @@
 //!
 //! With `W = Σ_p w_p ψ(E_p(u, α))`, `r_u = Σ w Bᵀ S`, `r_α = Σ w Mᵀ S`: the parameters `α`
 //! solve `r_α(u, α) = 0` by a local Newton iteration started from the committed values
-//! (`PointState::enhanced`, so they are saved across increments and in checkpoints), and
+//! (`PointState::enhanced`, so they are saved across increments and in checkpoints), with
+//! full steps and, where those fail (a 2-cycle across the elastic-plastic switch of some
+//! points, or an overshoot into material inversion), again with halved steps
+//! (`SolidShell::solve_enhanced_parameters`), and
 //!
 //! ```text
 //! f = r_u(u, α(u)),    K = K_uu - K_uα K_αα⁻¹ K_αu,
@@ -109,8 +112,14 @@ pub(super) const COMPONENTS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 
 /// In-plane Gauss abscissa `1/√3`.
 const GAUSS: f64 = 0.577_350_269_189_625_8;
 
+/// The enhanced parameters of one element.
+type Modes = SVector<f64, ENHANCED_PARAMETERS>;
+
 /// Most local Newton iterations for the EAS parameters.
 pub(super) const MAX_LOCAL_ITERATIONS: usize = 30;
+
+/// The smallest fraction of a local Newton step tried before the step is taken as it is.
+const MIN_LOCAL_STEP: f64 = 1.0 / 1024.0;
 
 /// The solid-shell hexahedron; see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -697,6 +706,91 @@ impl SolidShell {
         }
     }
 
+    /// Solves `r_α(u, α) = 0` for the enhanced parameters by Newton's method from `alpha`
+    /// (module docs), leaving the converged parameters in `alpha`, each point's stress and
+    /// tangent in `stresses` and `tangents` and its material state in `trial`. With `damped`,
+    /// a step that raises `|r_α|` (or leaves the material's domain) is halved and retried,
+    /// down to [`MIN_LOCAL_STEP`] of it: `-K_αα⁻¹ r_α` is a descent direction of `|r_α|²`,
+    /// so some fraction of it always lowers the residual. Full steps are tried first
+    /// (the caller): they are quadratic from nearby and need no extra evaluation, and
+    /// from far away (an extrapolated first iterate) they can overshoot into material
+    /// inversion or wander, where the halved steps still get through.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_enhanced_parameters(
+        &self,
+        points: &[Point],
+        committed: &[PointState],
+        trial: &mut [PointState],
+        material: &dyn Material,
+        strain_scale: f64,
+        damped: bool,
+        alpha: &mut Modes,
+        stresses: &mut [Voigt],
+        tangents: &mut [Tangent],
+    ) -> Result<()> {
+        let ne = self.modes();
+        let mut previous_step = f64::INFINITY;
+        // The last Newton step taken: the parameters it started from, the step, the
+        // residual norm there and the fraction of the step taken.
+        let mut last: Option<(Modes, Modes, f64, f64)> = None;
+        let mut newton_steps = 0;
+        loop {
+            let mut r_a = Modes::zeros();
+            let mut k_aa = SMatrix::<f64, ENHANCED_PARAMETERS, ENHANCED_PARAMETERS>::zeros();
+            let mut failed = None;
+            for (p, point) in points.iter().enumerate() {
+                match self.material_at(point, alpha, &committed[p], &mut trial[p], material) {
+                    Ok((s, c)) => {
+                        r_a.gemv_tr(point.dv, &point.modes, &s, 1.0);
+                        let cm = c * point.modes;
+                        k_aa.gemm_tr(point.dv, &point.modes, &cm, 1.0);
+                        stresses[p] = s;
+                        tangents[p] = c;
+                    }
+                    Err(e) => {
+                        failed = Some(prefix(e, &format!("integration point {p}")));
+                        break;
+                    }
+                }
+            }
+            let norm = r_a.norm();
+            // Damped: a step that raised the residual (or left the material's domain) is
+            // halved and retried.
+            if let Some((from, step, norm_before, fraction)) = last.filter(|_| damped) {
+                let scale = strain_scale.max(from.amax());
+                let raised = failed.is_some() || !(norm <= norm_before);
+                if raised && fraction > MIN_LOCAL_STEP && fraction * step.amax() > 1e-9 * scale {
+                    let fraction = 0.5 * fraction;
+                    *alpha = from - step * fraction;
+                    last = Some((from, step, norm_before, fraction));
+                    continue;
+                }
+            }
+            if let Some(e) = failed {
+                return Err(e);
+            }
+            let step = solve_enhanced(k_aa, ne, &r_a)?;
+            let size = step.amax();
+            let scale = strain_scale.max(alpha.amax());
+            // Converged, or stalled at round-off (the step no longer shrinks).
+            if size <= 1e-14 * scale
+                || (newton_steps >= 2 && size <= 1e-9 * scale && size > 0.25 * previous_step)
+            {
+                return Ok(());
+            }
+            if newton_steps >= MAX_LOCAL_ITERATIONS || !size.is_finite() {
+                return Err(Error::NoConvergence(format!(
+                    "enhanced-strain parameters not converged after {newton_steps} local \
+                     iterations (last step {size:e})"
+                )));
+            }
+            previous_step = size;
+            last = Some((*alpha, step, norm, 1.0));
+            newton_steps += 1;
+            *alpha -= step;
+        }
+    }
+
     /// The output part of a converged point's `trial`: Cauchy stress (finite strain:
     /// [`cauchy_stress`]), `F` and the enhanced parameters.
     fn finish_point(
@@ -812,7 +906,6 @@ impl Element<DOFS> for SolidShell {
         force: &mut [f64],
         stiffness: Option<&mut [f64]>,
     ) -> Result<()> {
-        type Modes = SVector<f64, ENHANCED_PARAMETERS>;
         super::hex8::check_len("force", force.len(), DOFS)?;
         if let Some(k) = &stiffness {
             super::hex8::check_len("stiffness", k.len(), DOFS * DOFS)?;
@@ -833,37 +926,24 @@ impl Element<DOFS> for SolidShell {
         let np = points.len();
         let mut stresses = [Voigt::zeros(); 4 * MAX_THICKNESS_POINTS];
         let mut tangents = [Tangent::zeros(); 4 * MAX_THICKNESS_POINTS];
-        let mut previous_step = f64::INFINITY;
-        for iteration in 0.. {
-            let mut r_a = Modes::zeros();
-            let mut k_aa = SMatrix::<f64, ENHANCED_PARAMETERS, ENHANCED_PARAMETERS>::zeros();
-            for (p, point) in points.iter().enumerate() {
-                let (s, c) = self
-                    .material_at(point, &alpha, &committed[p], &mut trial[p], material)
-                    .map_err(|e| prefix(e, &format!("integration point {p}")))?;
-                r_a.gemv_tr(point.dv, &point.modes, &s, 1.0);
-                let cm = c * point.modes;
-                k_aa.gemm_tr(point.dv, &point.modes, &cm, 1.0);
-                stresses[p] = s;
-                tangents[p] = c;
-            }
-            let step = solve_enhanced(k_aa, ne, &r_a)?;
-            let size = step.amax();
-            let scale = strain_scale.max(alpha.amax());
-            // Converged, or stalled at round-off (the step no longer shrinks).
-            if size <= 1e-14 * scale
-                || (iteration >= 2 && size <= 1e-9 * scale && size > 0.25 * previous_step)
-            {
-                break;
-            }
-            if iteration >= MAX_LOCAL_ITERATIONS || !size.is_finite() {
-                return Err(Error::NoConvergence(format!(
-                    "enhanced-strain parameters not converged after {iteration} local \
-                     iterations (last step {size:e})"
-                )));
-            }
-            previous_step = size;
-            alpha -= step;
+        // Full steps first; halved ones only where those fail (doc of the method).
+        let from = alpha;
+        let mut local = |damped: bool, alpha: &mut Modes| {
+            self.solve_enhanced_parameters(
+                &points,
+                committed,
+                trial,
+                material,
+                strain_scale,
+                damped,
+                alpha,
+                &mut stresses,
+                &mut tangents,
+            )
+        };
+        if let Err(full_steps) = local(false, &mut alpha) {
+            alpha = from;
+            local(true, &mut alpha).map_err(|_| full_steps)?;
         }
         let force: &mut [f64; DOFS] = force.try_into().expect("length checked");
         let mut f = SVector::<f64, DOFS>::zeros();
