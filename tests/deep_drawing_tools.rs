@@ -241,3 +241,55 @@ fn bvh_gives_the_same_projections_as_the_full_search() {
         }
     }
 }
+
+/// The 26-DOP test only skips patches that cannot hold a closer foot: projections with and
+/// without it are identical, bit for bit (foot, normal, gap, normal gradient, patch and
+/// parameters), for 10^4 random points around each of the quarter punch, die and blankholder
+/// the square cup uses, and the full die, cold and warm started.
+#[test]
+fn hull_test_skips_no_closer_patch() {
+    let tools = [
+        punch_patches(&punch_spec(), Extent::Quarter { margin: 2.0 }).unwrap(),
+        die_patches(&die_spec(), Extent::Quarter { margin: 2.0 }).unwrap(),
+        blankholder_patches(
+            &BlankholderSpec::numisheet93(0.81),
+            Extent::Quarter { margin: 2.0 },
+        )
+        .unwrap(),
+        die_patches(&die_spec(), Extent::Full).unwrap(),
+    ];
+    let mut rng = Rng(33);
+    for patches in tools {
+        let with = PatchSurface::new(patches.clone()).unwrap();
+        let without = PatchSurface::new(patches).unwrap().without_hulls();
+        let mut hint = None;
+        let mut defined = 0;
+        for _ in 0..10_000 {
+            let x = Vec3::new(
+                rng.uniform(-85.0, 85.0),
+                rng.uniform(-85.0, 85.0),
+                rng.uniform(-60.0, 40.0),
+            );
+            let previous = hint;
+            for h in [None, previous.as_ref()] {
+                match (with.project(&x, h), without.project(&x, h)) {
+                    (Some(a), Some(b)) => {
+                        assert!(
+                            a.foot == b.foot
+                                && a.normal == b.normal
+                                && a.gap == b.gap
+                                && a.normal_gradient == b.normal_gradient
+                                && a.hint == b.hint,
+                            "x = {x:?}: {a:?} vs {b:?}"
+                        );
+                        hint = Some(a.hint);
+                        defined += 1;
+                    }
+                    (None, None) => {}
+                    _ => panic!("defined with one search only at {x:?}"),
+                }
+            }
+        }
+        assert!(defined > 15_000, "{defined}");
+    }
+}

@@ -13,6 +13,7 @@ pub mod builders;
 pub mod bvh;
 mod check;
 pub mod cylinder;
+pub mod kdop;
 pub mod nurbs;
 pub mod patch_surface;
 pub mod patch_table;

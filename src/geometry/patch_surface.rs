@@ -30,6 +30,7 @@
 
 use super::bezier::{BezierPatch, PatchPoint};
 use super::bvh::{box_distance, Bvh};
+use super::kdop::Kdop;
 use super::seams::{seam_report, SeamReport};
 use super::trim::PieceTrim;
 use super::*;
@@ -50,6 +51,12 @@ pub struct PatchSurface {
     bvh: Bvh,
     /// Search with the tree (default) or by sorting all boxes (kept to cross-check it).
     use_bvh: bool,
+    /// Control-point 26-DOPs: a tighter lower bound than `boxes` on the distance to a
+    /// patch, checked before a patch the tree offers is projected on.
+    hulls: Vec<Kdop>,
+    /// Skip patches by `hulls` (default) or project on every patch the tree offers (kept
+    /// to cross-check that the skipping changes no answer).
+    use_hulls: bool,
     /// Diagonal of the whole surface's box: the length scale of tolerances.
     scale: f64,
     /// Worst gap and kink where patches meet, measured at construction.
@@ -150,9 +157,11 @@ impl PatchSurface {
         let mut surface = PatchSurface {
             cold_grid,
             bvh: Bvh::new(&boxes),
+            hulls: patches.iter().map(|p| Kdop::around(p.points())).collect(),
             patches,
             boxes,
             use_bvh: true,
+            use_hulls: true,
             scale: (hi - lo).norm(),
             seams: SeamReport::default(),
             trims,
@@ -216,6 +225,13 @@ impl PatchSurface {
     /// kept to check the tree gives the same answers.
     pub fn without_bvh(mut self) -> PatchSurface {
         self.use_bvh = false;
+        self
+    }
+
+    /// The same surface projecting on every patch whose box is near enough, without the
+    /// tighter 26-DOP test: slower, kept to check that test changes no answer.
+    pub fn without_hulls(mut self) -> PatchSurface {
+        self.use_hulls = false;
         self
     }
 
@@ -487,8 +503,20 @@ impl RigidSurface for PatchSurface {
             Some((_, b)) => b.dist + tol,
         };
         let bound = bound_of(&best);
+        // The distance a candidate must beat to replace the best (the rules below): a
+        // patch whose hull is farther cannot, so its projection is skipped. The margin
+        // (1e-12 of the size) covers the rounding of the bound and of the foot's distance.
+        let to_beat = |best: &Option<(usize, Local)>| match best {
+            None => f64::INFINITY,
+            Some((kb, b)) if b.kind == Kind::Interior => {
+                b.dist - if Some(*kb) == hinted_patch { tol } else { 0.0 }
+            }
+            Some((_, b)) => b.dist + tol,
+        };
         self.nearest_patches(x, bound, |k, _| {
-            if Some(k) != hinted_patch {
+            let hopeless = self.use_hulls
+                && self.hulls[k].distance_lower_bound(x) > to_beat(&best) + 1e-12 * self.scale;
+            if Some(k) != hinted_patch && !hopeless {
                 let c = self.closest_on_patch(k, x, None);
                 let replace = match &best {
                     _ if !self.on_face(k, &c) => false,
