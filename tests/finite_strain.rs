@@ -510,3 +510,74 @@ fn small_strain_energy_balance_includes_plastic_dissipation() {
     assert!(e.plastic_dissipation > e.elastic_energy, "mostly plastic");
     assert!(e.relative_error.abs() < 1e-9, "{}", e.relative_error);
 }
+
+/// The `equivalent_stress` cell field is the yield function's own equivalent stress
+/// (Hill48's `φ` of the stress the material works in), which plastic points keep equal to
+/// the yield stress: a unit cube of the Hill48 steel (r0, r45, r90 = 0.7, 1.3, 2.1) pulled
+/// 10 % across the rolling direction, under finite and small strain. At every plastic
+/// increment the field equals the Swift yield stress at the element's equivalent plastic
+/// strain to 1e-8 (homogeneous: every point the same; the return mapping's tolerance),
+/// while the von Mises stress, the uniaxial stress across the rolling direction, is
+/// `1 / sqrt(F + H) = 1.28` times as large (Hill48 normalised along the rolling
+/// direction, `G + H = 1`, `H = r0 / (1 + r0)`, `F = H / r90`; finite strain: divided by
+/// `J`, within 0.5 %).
+#[test]
+fn equivalent_stress_field_is_the_yield_functions() {
+    let (r0, r90) = (LANKFORD.0, LANKFORD.2);
+    let h = r0 / (1.0 + r0);
+    let across = 1.0 / (h / r90 + h).sqrt();
+    for kinematics in [StrainTheory::Finite, StrainTheory::Small] {
+        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [1, 1, 1]).unwrap();
+        let mut model = Model::new(mesh, Arc::new(hill_swift(0.0))).unwrap();
+        model
+            .prescribe(
+                "y+",
+                "y",
+                ScalarSchedule::new(vec![(0.0, 0.0), (1.0, 0.1)]).unwrap(),
+            )
+            .unwrap();
+        for (set, c) in [("x-", "x"), ("y-", "y"), ("z-", "z")] {
+            model
+                .prescribe(set, c, ScalarSchedule::constant(0.0))
+                .unwrap();
+        }
+        model.settings.kinematics = kinematics;
+        model.settings.increments = 20;
+        model.settings.force_rel_tol = 1e-10;
+        let mut sim = Simulation::new(model).unwrap();
+        let mut plastic = 0;
+        while !sim.is_finished() {
+            sim.step().unwrap();
+            let frame = tribo::output::frame(&sim, tribo::output::Configuration::Current);
+            let cell = |name: &str| {
+                frame
+                    .cell_data
+                    .iter()
+                    .find(|f| f.name == name)
+                    .unwrap_or_else(|| panic!("field {name}"))
+                    .values[0]
+            };
+            let ep = cell("equivalent_plastic_strain");
+            if ep <= 0.0 {
+                continue;
+            }
+            plastic += 1;
+            let equivalent = cell("equivalent_stress");
+            let error = (equivalent - swift(ep)).abs() / swift(ep);
+            let ratio = cell("von_mises") / equivalent;
+            assert!(
+                error < 1e-8,
+                "{kinematics:?}: {equivalent} against {}",
+                swift(ep)
+            );
+            assert!(
+                (ratio / across - 1.0).abs() < 5e-3,
+                "{kinematics:?}: von Mises / equivalent {ratio}, expected {across}"
+            );
+        }
+        assert!(
+            plastic >= 15,
+            "{kinematics:?}: {plastic} plastic increments"
+        );
+    }
+}

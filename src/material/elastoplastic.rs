@@ -373,6 +373,12 @@ impl Material for ElastoPlastic {
         self.elastic.energy_density_of_stress(&state.stress)
     }
 
+    /// Hill48's `φ` (von Mises for isotropic coefficients), in the material axes.
+    fn equivalent_stress(&self, state: &PointState, finite: bool) -> f64 {
+        self.yield_function
+            .equivalent_stress(state.material_stress(finite))
+    }
+
     fn describe(&self) -> String {
         format!(
             "elastoplastic E={} nu={}, {}, {}",

@@ -97,6 +97,18 @@ pub struct PointState {
 /// ([`PointState::enhanced`]).
 pub const ENHANCED_PARAMETERS: usize = 6;
 
+impl PointState {
+    /// The stress the material model works in: `log_stress` under finite kinematics,
+    /// `stress` (Cauchy, equal to the small-strain stress) under small strain.
+    pub fn material_stress(&self, finite: bool) -> &Voigt {
+        if finite {
+            &self.log_stress
+        } else {
+            &self.stress
+        }
+    }
+}
+
 impl Default for PointState {
     /// The virgin state: stress- and strain-free, `F = I`.
     fn default() -> Self {
@@ -240,6 +252,15 @@ pub trait Material: std::fmt::Debug + Send + Sync {
 
     /// Stored elastic energy per unit (reference) volume in `state`.
     fn elastic_energy_density(&self, state: &PointState) -> f64;
+
+    /// The equivalent stress of the model's yield function at `state` (the value its
+    /// plastic points keep equal to the current yield stress), of the stress the model
+    /// works in: the log-space stress `log_stress` under finite kinematics (`finite`), the
+    /// Cauchy stress `stress` under small strain. The default, for models without a yield
+    /// function, is the von Mises stress of that stress.
+    fn equivalent_stress(&self, state: &PointState, finite: bool) -> f64 {
+        von_mises(state.material_stress(finite))
+    }
 
     /// The state of a virgin point. Defaults to [`PointState::default`].
     fn initial_state(&self) -> PointState {

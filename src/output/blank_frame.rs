@@ -9,6 +9,7 @@
 
 use super::{Field, Frame};
 use crate::contact::ContactStatus;
+use crate::element::StrainTheory;
 use crate::geometry::Vec3;
 use crate::solver::Simulation;
 use crate::{Error, Result};
@@ -128,7 +129,11 @@ fn nodal_contact(sim: &Simulation, only: Option<usize>) -> NodalContact {
 /// fields on the nodes (and, for sheet meshes with through-thickness columns, the current
 /// thickness and the thickness strain ln(t/t0) of each column on its nodes),
 /// element-averaged Cauchy stress (components named xx, yy, zz, xy, yz, xz), von Mises
-/// stress and equivalent plastic strain on the cells; for solid-shell models also the values
+/// stress (of that mean), the mean of the points' equivalent stress of the material's
+/// yield function (Hill48's `φ` of the stress the material works in, which plastic points
+/// keep at the yield stress;
+/// [`Material::equivalent_stress`](crate::material::Material::equivalent_stress)) and equivalent plastic
+/// strain on the cells; for solid-shell models also the values
 /// at the faces and the mid-surface (`shell_layers`).
 pub fn frame(sim: &Simulation, configuration: Configuration) -> Frame {
     frame_against(sim, configuration, None)
@@ -145,6 +150,9 @@ pub fn frame_against(sim: &Simulation, configuration: Configuration, only: Optio
     let mut stress = vec![0.0; 6 * mesh.hexes.len()];
     let mut von_mises = vec![0.0; mesh.hexes.len()];
     let mut eq_plastic = vec![0.0; mesh.hexes.len()];
+    let mut equivalent = vec![0.0; mesh.hexes.len()];
+    let finite = sim.model.settings.kinematics == StrainTheory::Finite;
+    let material = &sim.model.material;
     for e in 0..mesh.hexes.len() {
         let pts = &sim.points()[e * per..(e + 1) * per];
         for p in pts {
@@ -152,6 +160,7 @@ pub fn frame_against(sim: &Simulation, configuration: Configuration, only: Optio
                 stress[6 * e + i] += p.stress[i] / per as f64;
             }
             eq_plastic[e] += p.eq_plastic_strain / per as f64;
+            equivalent[e] += material.equivalent_stress(p, finite) / per as f64;
         }
         let s = &stress[6 * e..6 * e + 6];
         von_mises[e] = (0.5
@@ -203,6 +212,7 @@ pub fn frame_against(sim: &Simulation, configuration: Configuration, only: Optio
         cell_data: vec![
             Field::symmetric_tensor("stress", stress),
             Field::scalar("von_mises", von_mises),
+            Field::scalar("equivalent_stress", equivalent),
             Field::scalar("equivalent_plastic_strain", eq_plastic),
         ]
         .into_iter()
