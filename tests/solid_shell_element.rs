@@ -73,6 +73,15 @@ fn evaluate(
     )
 }
 
+/// Largest entry of `a - b` relative to the largest entry of `b`.
+fn relative(a: &[f64], b: &[f64]) -> f64 {
+    let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
+        / scale
+}
+
 /// Largest relative difference between the tangent and central differences of the force
 /// (step 1e-8 on a 0.1-thick element: truncation ~1e-16 relative, round-off
 /// ~1e-16 |f| / 1e-8 ~ 1e-8 |K| h).
@@ -428,13 +437,6 @@ fn tuned_kernel_equals_the_original() {
     let strain: [Vec3; 8] = std::array::from_fn(|_| rng.vec() * 0.004);
     let elastic = LinearElastic::new(70e3, 0.33).unwrap();
     let plastic = hill_swift();
-    let relative = |a: &[f64], b: &[f64]| {
-        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        a.iter()
-            .zip(b)
-            .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
-            / scale
-    };
     for finite in [true, false] {
         let el = shell(finite);
         let at = |f: f64| -> [Vec3; 8] {
@@ -542,13 +544,6 @@ fn halved_local_steps_converge_where_full_steps_fail() {
     );
     let el = shell(true);
     let virgin = vec![PointState::default(); el.point_count()];
-    let relative = |a: &[f64], b: &[f64]| {
-        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        a.iter()
-            .zip(b)
-            .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
-            / scale
-    };
     let (mut f_ref, mut k_ref) = (vec![0.0; 24], vec![0.0; 576]);
     let full_steps = tribo::element::solid_shell_reference::evaluate_into(
         &el,

@@ -13,6 +13,8 @@
 //!   the benchmark's Coulomb friction;
 //! - the benchmark's blankholder, under force control, carries 4 x 4.9 kN on the full cup.
 
+mod common;
+
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -247,37 +249,14 @@ fn both_linear_solvers_give_the_same_cup() {
 /// Runs the cup script (8 x 8 x 1, 3 mm) with the factorization `linear_solver` and the
 /// settings `extra` added to its own (a copy of the script, next to the output).
 fn run_cup_settings(variant: &str, linear_solver: &str, extra: &str, out: &Path) -> Value {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let source = std::fs::read_to_string(root.join("scripts/square_cup.rhai")).unwrap();
+    let sets = [
+        "cells=8".to_string(),
+        "travel=3.0".to_string(),
+        format!("variant=\"{variant}\""),
+        format!("linear_solver=\"{linear_solver}\""),
+    ];
     let marker = "linear_solver: linear_solver,";
-    assert!(
-        source.contains(marker),
-        "the cup script sets its linear solver"
-    );
-    let source = source.replace(marker, &format!("{marker} {extra}"));
-    let _ = std::fs::remove_dir_all(out);
-    let folder = out.with_extension("script");
-    std::fs::create_dir_all(&folder).unwrap();
-    let script = folder.join("square_cup.rhai");
-    std::fs::write(&script, source).unwrap();
-    let status = Command::new(env!("CARGO_BIN_EXE_tribo"))
-        .arg("run")
-        .arg(&script)
-        .args(["--quiet", "--out"])
-        .arg(out)
-        .args(["--set", "cells=8", "--set", "travel=3.0", "--set"])
-        .arg(format!("variant=\"{variant}\""))
-        .arg("--set")
-        .arg(format!("linear_solver=\"{linear_solver}\""))
-        .status()
-        .expect("tribo runs");
-    assert!(
-        status.success(),
-        "square cup ({variant}, {linear_solver}, {extra}) failed"
-    );
-    let _ = std::fs::remove_dir_all(&folder);
-    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
-    serde_json::from_str(&text).expect("summary.json is JSON")
+    common::run_edited_script("square_cup.rhai", marker, &format!(" {extra}"), &sets, out)
 }
 
 /// Runs the cup with the multipliers eliminated or not, Newton steps not re-solved on

@@ -6,9 +6,10 @@
 //! iterations in all (measured 45 -> 36 and 55 -> 46) and no increment above issue 14's
 //! bound of 25 (the first increments take 8 and 17 with prediction, 17 and 13 without).
 
+mod common;
+
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn out_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!(
@@ -17,32 +18,6 @@ fn out_dir(name: &str) -> PathBuf {
     ));
     let _ = std::fs::remove_dir_all(&dir);
     dir
-}
-
-/// Runs a copy of `script` (under scripts/) with `extra` appended to the settings text
-/// `marker` and the overrides `sets`; its summary.json. The copy is removed, the output
-/// directory `out` kept.
-fn run_script(script: &str, marker: &str, extra: &str, sets: &[String], out: &Path) -> Value {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let source = std::fs::read_to_string(root.join("scripts").join(script)).unwrap();
-    assert!(source.contains(marker), "{script} has {marker}");
-    let folder = out.with_extension("script");
-    std::fs::create_dir_all(&folder).unwrap();
-    let copy = folder.join(script);
-    std::fs::write(&copy, source.replace(marker, &format!("{marker}{extra}"))).unwrap();
-    let mut command = Command::new(env!("CARGO_BIN_EXE_tribo"));
-    command
-        .arg("run")
-        .arg(&copy)
-        .args(["--quiet", "--set", "charts=false", "--out"])
-        .arg(out);
-    for s in sets {
-        command.args(["--set", s]);
-    }
-    let status = command.status().expect("tribo runs");
-    assert!(status.success(), "{script} ({extra}, {sets:?}) failed");
-    let _ = std::fs::remove_dir_all(&folder);
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
 /// Runs the square cup (8 x 8 x 1, 3 mm) with `extra` inserted into its settings;
@@ -54,7 +29,8 @@ fn run_cup(variant: &str, extra: &str, out: &Path) -> (Value, Vec<usize>) {
         format!("variant=\"{variant}\""),
     ];
     let marker = "linear_solver: linear_solver,";
-    let summary = run_script("square_cup.rhai", marker, &format!(" {extra}"), &sets, out);
+    let summary =
+        common::run_edited_script("square_cup.rhai", marker, &format!(" {extra}"), &sets, out);
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
     let mut lines = history.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -127,7 +103,7 @@ fn status_prediction_keeps_the_cup_and_shortens_newton() {
 #[test]
 fn runaway_re_solves_are_not_kept() {
     let out = out_dir("cylindrical");
-    let summary = run_script(
+    let summary = common::run_edited_script(
         "cylindrical_cup.rhai",
         "max_cutbacks: max_cutbacks, max_iterations: max_iterations",
         ", status_prediction: 8",

@@ -245,3 +245,37 @@ pub fn elastica(alpha: f64) -> f64 {
     }
     shoot(0.5 * (lo + hi))[2]
 }
+
+/// Runs `scripts/<script>` with `extra` inserted right after `marker` (an entry of the
+/// script's settings map), under `--quiet --set charts=false` and the `sets` overrides,
+/// into `out` (emptied first), and returns its summary.json. The edited copy is written
+/// next to `out` and removed after the run.
+pub fn run_edited_script(
+    script: &str,
+    marker: &str,
+    extra: &str,
+    sets: &[String],
+    out: &std::path::Path,
+) -> serde_json::Value {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let source = std::fs::read_to_string(root.join("scripts").join(script)).unwrap();
+    assert!(source.contains(marker), "{script} has {marker}");
+    let _ = std::fs::remove_dir_all(out);
+    let folder = out.with_extension("script");
+    std::fs::create_dir_all(&folder).unwrap();
+    let copy = folder.join(script);
+    std::fs::write(&copy, source.replace(marker, &format!("{marker}{extra}"))).unwrap();
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"));
+    command
+        .arg("run")
+        .arg(&copy)
+        .args(["--quiet", "--set", "charts=false", "--out"])
+        .arg(out);
+    for s in sets {
+        command.args(["--set", s]);
+    }
+    let status = command.status().expect("tribo runs");
+    assert!(status.success(), "{script} ({extra}, {sets:?}) failed");
+    let _ = std::fs::remove_dir_all(&folder);
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
