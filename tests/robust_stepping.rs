@@ -307,6 +307,15 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
         "lands exactly on the schedule's breakpoint t = 1"
     );
     assert!(total >= 1.0, "cutbacks recorded in history.csv");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(adaptive_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let reasons = summary["cutback_reasons"].as_array().unwrap();
+    assert_eq!(
+        reasons.len() as f64,
+        total,
+        "one reason per cutback: {reasons:?}"
+    );
     let _ = std::fs::remove_dir_all(&fixed_dir);
     let _ = std::fs::remove_dir_all(&adaptive_dir);
 }
@@ -512,5 +521,26 @@ fn fixed_step_cutbacks_are_counted_once() {
         total >= 1.0,
         "the fast drag needs cutbacks in two fixed steps"
     );
+    // summary.json gives each cutback its reason, under the row that followed it.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let reasons = summary["cutback_reasons"].as_array().unwrap();
+    assert_eq!(reasons.len() as f64, total);
+    for (k, &c) in cutbacks.iter().enumerate() {
+        let here: Vec<&str> = reasons
+            .iter()
+            .filter(|r| r["increment"].as_u64() == Some(k as u64 + 1))
+            .map(|r| r["reason"].as_str().unwrap())
+            .collect();
+        assert_eq!(here.len() as f64, c, "row {k}: {here:?}");
+        for why in here {
+            println!("row {k}: cut back at {why}");
+            assert!(why.starts_with("t = ") && why.contains("(dt = "), "{why}");
+            assert!(
+                why.contains("Newton") || why.contains("iterations"),
+                "names the failure: {why}"
+            );
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

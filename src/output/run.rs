@@ -467,6 +467,12 @@ impl RunOutput {
             "increments": sim.history.len(),
             "newton_iterations": iterations,
             "cutbacks": sim.history.iter().map(|r| r.cutbacks).sum::<usize>(),
+            "cutback_reasons": sim.history.iter().flat_map(|r| {
+                r.cutback_reasons.iter().map(move |why| serde_json::json!({
+                    "increment": r.index,
+                    "reason": why,
+                }))
+            }).collect::<Vec<_>>(),
             "symbolic_analyses": sim.symbolic_analyses(),
             "wall_time_s": wall_time_s,
             "phase_times_s": {

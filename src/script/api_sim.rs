@@ -515,6 +515,15 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     m.insert("time".into(), Dynamic::from(r.time));
     m.insert("iterations".into(), Dynamic::from(r.iterations as i64));
     m.insert("cutbacks".into(), Dynamic::from(r.cutbacks as i64));
+    m.insert(
+        "cutback_reasons".into(),
+        Dynamic::from(
+            r.cutback_reasons
+                .iter()
+                .map(|why| Dynamic::from(why.clone()))
+                .collect::<Array>(),
+        ),
+    );
     m.insert("dt".into(), Dynamic::from(r.dt));
     m.insert("rejected_steps".into(), Dynamic::from(r.rejected as i64));
     m.insert(

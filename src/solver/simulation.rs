@@ -54,6 +54,10 @@ pub struct IncrementReport {
     pub cycling: Vec<CyclingNode>,
     /// Anything the user should know about this increment.
     pub warnings: Vec<String>,
+    /// Why each failed attempt before this increment was cut back ("t = .. (dt = ..): the
+    /// error"), one per cutback counted in `cutbacks`.
+    #[serde(default)]
+    pub cutback_reasons: Vec<String>,
 }
 
 /// Failures after which a smaller increment may succeed.
@@ -64,6 +68,11 @@ const PLAIN_RETRY_ITERATIONS: usize = 20;
 
 fn retryable(err: &Error) -> bool {
     matches!(err, Error::NoConvergence(_) | Error::LinearSolver(_))
+}
+
+/// One line on a failed attempt: where it was tried and why it failed.
+fn cutback_reason(t_new: f64, dt: f64, err: &Error) -> String {
+    format!("t = {t_new} (dt = {dt}): {}", bare(err))
 }
 
 /// An error's message without its kind prefix, for nesting in another message.
@@ -374,6 +383,7 @@ impl Simulation {
         let target = (self.time + self.nominal_dt()).min(self.model.settings.end_time);
         let mut dt = target - self.time;
         let (mut cutbacks, mut recorded) = (0, 0);
+        let mut reasons = Vec::new();
         loop {
             let t_new = if dt >= target - self.time {
                 target
@@ -384,6 +394,7 @@ impl Simulation {
                 Ok(trial) => {
                     let mut report = self.accept(t_new, trial);
                     report.cutbacks = cutbacks - recorded;
+                    report.cutback_reasons = reasons[recorded..].to_vec();
                     recorded = cutbacks;
                     self.history.push(report.clone());
                     if t_new < target {
@@ -391,10 +402,12 @@ impl Simulation {
                         continue;
                     }
                     report.cutbacks = cutbacks;
+                    report.cutback_reasons = reasons;
                     return Ok(report);
                 }
                 Err(err @ Error::Interrupted(_)) => return Err(err),
                 Err(err) if retryable(&err) && cutbacks < self.model.settings.max_cutbacks => {
+                    reasons.push(cutback_reason(t_new, t_new - self.time, &err));
                     cutbacks += 1;
                     dt *= 0.5;
                 }
@@ -416,6 +429,7 @@ impl Simulation {
         let dt_min = step.dt_min(end);
         let mut dt = self.controller.dt.max(dt_min);
         let (mut cutbacks, mut rejected) = (0, 0);
+        let mut reasons = Vec::new();
         loop {
             let t_new = StepController::next_time(self.time, dt, &self.stops);
             let dt_used = t_new - self.time;
@@ -432,6 +446,7 @@ impl Simulation {
                     }
                     let mut report = self.accept(t_new, trial);
                     report.cutbacks = cutbacks;
+                    report.cutback_reasons = std::mem::take(&mut reasons);
                     report.rejected = rejected;
                     report.measures = measures;
                     report.limit = verdict.limit;
@@ -460,6 +475,7 @@ impl Simulation {
                 }
                 Err(err @ Error::Interrupted(_)) => return Err(err),
                 Err(err) if retryable(&err) && dt_used > dt_min * (1.0 + 1e-9) => {
+                    reasons.push(cutback_reason(t_new, dt_used, &err));
                     cutbacks += 1;
                     dt = (0.5 * dt_used).max(dt_min);
                     self.controller.limit = Limit::Divergence;
@@ -695,6 +711,7 @@ impl Simulation {
             line_search_cuts: 0,
             cycling: Vec::new(),
             warnings: Vec::new(),
+            cutback_reasons: Vec::new(),
         }
     }
 
