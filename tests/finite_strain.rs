@@ -581,3 +581,33 @@ fn equivalent_stress_field_is_the_yield_functions() {
         );
     }
 }
+
+/// An element that inverts inside a Newton iterate makes the attempt fail as "no
+/// convergence" (retryable: a smaller step may pass) and names the element, with the kind
+/// prefix once: a unit cube squashed through itself (by 1.5 times its height) in one
+/// increment with one halving allowed, under finite strain.
+#[test]
+fn an_inverted_element_is_named_once_in_the_cutback_reason() {
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [1, 1, 1]).unwrap();
+    let mut model = Model::new(mesh, Arc::new(hill_swift(0.0))).unwrap();
+    model
+        .prescribe(
+            "z+",
+            "z",
+            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, -1.5)]).unwrap(),
+        )
+        .unwrap();
+    for (set, c) in [("x-", "x"), ("y-", "y"), ("z-", "z")] {
+        model
+            .prescribe(set, c, ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
+    model.settings.kinematics = StrainTheory::Finite;
+    model.settings.increments = 1;
+    model.settings.max_cutbacks = 1;
+    let mut sim = Simulation::new(model).unwrap();
+    let err = sim.step().unwrap_err().to_string();
+    println!("{err}");
+    assert!(err.contains("element 0"), "{err}");
+    assert_eq!(err.matches("no convergence").count(), 1, "{err}");
+}

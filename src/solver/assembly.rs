@@ -193,7 +193,12 @@ fn evaluate_elements(
                         force_e,
                         stiffness_e,
                     )
-                    .map_err(|err| Error::NoConvergence(in_element(err, e).to_string()))?;
+                    // Any element failure inside an iterate is retryable (a smaller step
+                    // may pass), kept as "no convergence" without a second kind prefix.
+                    .map_err(|err| match in_element(err, e) {
+                        err @ Error::NoConvergence(_) => err,
+                        other => Error::NoConvergence(other.to_string()),
+                    })?;
             }
             Ok::<_, Error>(())
         };
