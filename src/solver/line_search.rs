@@ -107,7 +107,10 @@ impl Simulation {
                 let e = ctx.complete(&xn, e, times)?;
                 Ok((xn, e, LINE_SEARCH_CUTS))
             }
-            (None, Some(err)) => Err(err),
+            (None, Some(err)) => Err(crate::element::prefix(
+                err,
+                "every line-search trial failed, the last one",
+            )),
             (None, None) => Err(Error::NoConvergence(
                 "non-finite residual at every line-search step".into(),
             )),

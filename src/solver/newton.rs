@@ -273,8 +273,17 @@ impl Simulation {
         if settings.extrapolate {
             self.extrapolate(t_new, &mut x);
         }
-        self.start_iterate(&ctx, t_new, &mut x, linear, &mut times)?;
-        let mut eval = ctx.evaluate(&x, &mut times)?;
+        // Named in the error: a first iterate that cannot be evaluated (an element inverted
+        // by the extrapolated guess, say) fails the attempt before Newton starts.
+        let first = if unextrapolated.is_some() {
+            "at the first iterate (extrapolated from the last increment)"
+        } else {
+            "at the first iterate"
+        };
+        let mut eval = self
+            .start_iterate(&ctx, t_new, &mut x, linear, &mut times)
+            .and_then(|()| ctx.evaluate(&x, &mut times))
+            .map_err(|err| crate::element::prefix(err, first))?;
         // The extrapolated start is a guess that the increment continues the last one's
         // motion. Where it does not (a rotating thin beam: continued linearly, a rotation
         // stretches the fibres, whose membrane stiffness is (L/t)^2 times the bending one),
