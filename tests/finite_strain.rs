@@ -53,6 +53,26 @@ fn exact_uniaxial(eps: f64) -> (f64, f64) {
     (tau * (-(1.0 - 2.0 * POISSON) * tau / YOUNG).exp(), ep)
 }
 
+/// A unit cube of the Hill48 steel (rolling direction x) on the symmetry planes x-, y-,
+/// z-, the face `face` moved along `component` linearly from 0 at t = 0 to `travel` at t = 1.
+fn pulled_cube(face: &str, component: &str, travel: f64) -> Model {
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [1, 1, 1]).unwrap();
+    let mut model = Model::new(mesh, Arc::new(hill_swift(0.0))).unwrap();
+    model
+        .prescribe(
+            face,
+            component,
+            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, travel)]).unwrap(),
+        )
+        .unwrap();
+    for (set, c) in [("x-", "x"), ("y-", "y"), ("z-", "z")] {
+        model
+            .prescribe(set, c, ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
+    model
+}
+
 /// One unit cube, symmetry planes x-, y-, z-, the x+ face pulled to the stretch
 /// `exp(0.5)` in 100 increments with its lateral faces free (finite kinematics, F-bar).
 /// The Cauchy stress of every integration point against the exact curve, at every
@@ -61,21 +81,7 @@ fn exact_uniaxial(eps: f64) -> (f64, f64) {
 /// Also the energy balance: support work = Hencky energy + plastic dissipation.
 #[test]
 fn uniaxial_tension_to_50_percent_follows_the_swift_curve() {
-    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [1, 1, 1]).unwrap();
-    let mut model = Model::new(mesh, Arc::new(hill_swift(0.0))).unwrap();
-    let stretch = 0.5f64.exp();
-    model
-        .prescribe(
-            "x+",
-            "x",
-            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, stretch - 1.0)]).unwrap(),
-        )
-        .unwrap();
-    for (set, c) in [("x-", "x"), ("y-", "y"), ("z-", "z")] {
-        model
-            .prescribe(set, c, ScalarSchedule::constant(0.0))
-            .unwrap();
-    }
+    let mut model = pulled_cube("x+", "x", 0.5f64.exp() - 1.0);
     model.settings.kinematics = StrainTheory::Finite;
     model.settings.increments = 100;
     model.settings.force_rel_tol = 1e-10;
@@ -527,20 +533,7 @@ fn equivalent_stress_field_is_the_yield_functions() {
     let h = r0 / (1.0 + r0);
     let across = 1.0 / (h / r90 + h).sqrt();
     for kinematics in [StrainTheory::Finite, StrainTheory::Small] {
-        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [1, 1, 1]).unwrap();
-        let mut model = Model::new(mesh, Arc::new(hill_swift(0.0))).unwrap();
-        model
-            .prescribe(
-                "y+",
-                "y",
-                ScalarSchedule::new(vec![(0.0, 0.0), (1.0, 0.1)]).unwrap(),
-            )
-            .unwrap();
-        for (set, c) in [("x-", "x"), ("y-", "y"), ("z-", "z")] {
-            model
-                .prescribe(set, c, ScalarSchedule::constant(0.0))
-                .unwrap();
-        }
+        let mut model = pulled_cube("y+", "y", 0.1);
         model.settings.kinematics = kinematics;
         model.settings.increments = 20;
         model.settings.force_rel_tol = 1e-10;
@@ -589,20 +582,7 @@ fn equivalent_stress_field_is_the_yield_functions() {
 /// halving allowed, under finite strain.
 #[test]
 fn an_inverted_element_is_named_once_in_the_cutback_reason() {
-    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [1, 1, 1]).unwrap();
-    let mut model = Model::new(mesh, Arc::new(hill_swift(0.0))).unwrap();
-    model
-        .prescribe(
-            "z+",
-            "z",
-            ScalarSchedule::new(vec![(0.0, 0.0), (1.0, -1.5)]).unwrap(),
-        )
-        .unwrap();
-    for (set, c) in [("x-", "x"), ("y-", "y"), ("z-", "z")] {
-        model
-            .prescribe(set, c, ScalarSchedule::constant(0.0))
-            .unwrap();
-    }
+    let mut model = pulled_cube("z+", "z", -1.5);
     model.settings.kinematics = StrainTheory::Finite;
     model.settings.increments = 1;
     model.settings.max_cutbacks = 1;

@@ -489,30 +489,28 @@ impl RigidSurface for PatchSurface {
             .map(|h| (h.patch, self.closest_on_patch(h.patch, x, Some((h.u, h.v)))))
             .filter(|(k, loc)| self.on_face(*k, loc));
         let hinted_patch = hinted.map(|h| h.patch);
-        // Pruning bound: a candidate replaces the best only if closer by the hysteresis
-        // margin, or equally close (within tol) with a better-ranked foot. An interior best
-        // cannot be out-ranked, so then no box farther than its distance minus the margin
-        // can hold a winner (less 1e-14 of the size, so that a flat patch's box, exactly
-        // at the distance, is skipped despite the rounding of the foot's distance).
-        let bound_of = |best: &Option<(usize, Local)>| match best {
-            None => f64::INFINITY,
-            Some((kb, b)) if b.kind == Kind::Interior => {
-                let margin = if Some(*kb) == hinted_patch { tol } else { 0.0 };
-                b.dist - margin - 1e-14 * self.scale
-            }
-            Some((_, b)) => b.dist + tol,
-        };
-        let bound = bound_of(&best);
-        // The distance a candidate must beat to replace the best (the rules below): a
-        // patch whose hull is farther cannot, so its projection is skipped. The margin
-        // (1e-12 of the size) covers the rounding of the bound and of the foot's distance.
+        // The hysteresis margin a candidate must beat the best by: only the hinted patch
+        // has one (a node on a seam keeps its patch).
+        let margin = |kb: usize| if Some(kb) == hinted_patch { tol } else { 0.0 };
+        // The distance a candidate must beat to replace the best (the rules below): closer
+        // than an interior best by its margin (an interior foot cannot be out-ranked), or
+        // within tol of an edge or corner best with a better-ranked foot.
         let to_beat = |best: &Option<(usize, Local)>| match best {
             None => f64::INFINITY,
-            Some((kb, b)) if b.kind == Kind::Interior => {
-                b.dist - if Some(*kb) == hinted_patch { tol } else { 0.0 }
-            }
+            Some((kb, b)) if b.kind == Kind::Interior => b.dist - margin(*kb),
             Some((_, b)) => b.dist + tol,
         };
+        // Pruning bound of the boxes: no box farther than that distance can hold a winner
+        // (less 1e-14 of the size below an interior best, so that a flat patch's box,
+        // exactly at the distance, is skipped despite the rounding of the foot's distance).
+        let bound_of = |best: &Option<(usize, Local)>| match best {
+            Some((_, b)) if b.kind == Kind::Interior => to_beat(best) - 1e-14 * self.scale,
+            _ => to_beat(best),
+        };
+        let bound = bound_of(&best);
+        // A patch whose hull is farther than the distance to beat is not projected on; the
+        // margin (1e-12 of the size) covers the rounding of the bound and of the foot's
+        // distance.
         self.nearest_patches(x, bound, |k, _| {
             let hopeless = self.use_hulls
                 && self.hulls[k].distance_lower_bound(x) > to_beat(&best) + 1e-12 * self.scale;
@@ -522,11 +520,10 @@ impl RigidSurface for PatchSurface {
                     _ if !self.on_face(k, &c) => false,
                     None => true,
                     Some((kb, b)) => {
-                        let margin = if Some(*kb) == hinted_patch { tol } else { 0.0 };
                         if c.kind.rank() != b.kind.rank() && (c.dist - b.dist).abs() <= tol {
                             c.kind.rank() < b.kind.rank()
                         } else {
-                            c.dist < b.dist - margin
+                            c.dist < b.dist - margin(*kb)
                         }
                     }
                 };
