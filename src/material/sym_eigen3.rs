@@ -20,6 +20,11 @@ use crate::geometry::Mat3;
 /// convergence takes 3-5).
 const MAX_SWEEPS: usize = 30;
 
+/// `2^27`: from this `|τ|` on, a rotation's `t`, `c` and `s` are `0.5 / τ`, 1 and `t` to
+/// the last bit (`τ² >= 2^54`, so `1 + τ²` rounds to `τ²`; `t² <= 2^-56`, so `1 + t²`
+/// rounds to 1).
+const SMALL_ROTATION_TAU: f64 = 134_217_728.0;
+
 /// Eigenvalues and orthonormal eigenvectors (columns) of the symmetric `a` (only its upper
 /// triangle is read). Non-finite input gives non-finite output, as the caller checks.
 pub fn sym_eigen3(a: &Mat3) -> ([f64; 3], Mat3) {
@@ -62,15 +67,20 @@ fn rotate<const P: usize, const Q: usize, const R: usize>(
         return;
     }
     let tau = (m[Q][Q] - m[P][P]) / (2.0 * apq);
-    // sqrt(1 + τ²) rather than libm's hypot (several times slower); beyond 1e150,
-    // where τ² would overflow, t = 1/(2τ) to round-off.
-    let t = if tau.abs() > 1e150 {
-        0.5 / tau
+    let (t, c, s) = if tau.abs() >= SMALL_ROTATION_TAU {
+        // The late rotations of every decomposition: `a_pq` below 2^-28 of its pair's
+        // gap. There `1 + τ²` rounds to `τ²`, whose square root is `|τ|` exactly, so the
+        // general formula's `t` is `sign / (2|τ|) = 0.5 / τ`, and `1 + t²` rounds to 1,
+        // so `c = 1`, `s = t`: the same bits without two square roots and two divisions,
+        // which are the latency of the whole decomposition. Also where `τ²` overflows.
+        let t = 0.5 / tau;
+        (t, 1.0, t)
     } else {
-        tau.signum() / (tau.abs() + (1.0 + tau * tau).sqrt())
+        // sqrt(1 + τ²) rather than libm's hypot (several times slower).
+        let t = tau.signum() / (tau.abs() + (1.0 + tau * tau).sqrt());
+        let c = 1.0 / (1.0 + t * t).sqrt();
+        (t, c, t * c)
     };
-    let c = 1.0 / (1.0 + t * t).sqrt();
-    let s = t * c;
     m[P][P] -= t * apq;
     m[Q][Q] += t * apq;
     m[P][Q] = 0.0;
@@ -224,6 +234,42 @@ mod tests {
             let (l1, v1) = sym_eigen3(&a);
             let (l2, v2) = looped(&a);
             assert_eq!(bits(l1, v1), bits(l2, v2), "{a}");
+        }
+    }
+
+    /// The shortcut for small rotations gives the general formula's `t`, `c` and `s` bit
+    /// for bit, at and beyond its threshold and for either sign (the general formula
+    /// evaluated here as the module did before the shortcut, with its
+    /// branch for `τ²` overflowing).
+    #[test]
+    fn small_rotation_shortcut_is_the_general_formula_bit_for_bit() {
+        let general = |tau: f64| {
+            let t = if tau.abs() > 1e150 {
+                0.5 / tau
+            } else {
+                tau.signum() / (tau.abs() + (1.0 + tau * tau).sqrt())
+            };
+            let c = 1.0 / (1.0 + t * t).sqrt();
+            [t, c, t * c].map(f64::to_bits)
+        };
+        let mut seed = 17u64;
+        let mut rnd = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut taus = vec![SMALL_ROTATION_TAU, SMALL_ROTATION_TAU.next_up(), 1e20, 1e150];
+        for _ in 0..200_000 {
+            // Mantissas in [1, 2), exponents 27..=300.
+            taus.push((1.0 + rnd()) * 2f64.powi(27 + (rnd() * 274.0) as i32));
+        }
+        for tau in taus {
+            for tau in [tau, -tau] {
+                assert!(tau.abs() >= SMALL_ROTATION_TAU);
+                let t = 0.5 / tau;
+                assert_eq!([t, 1.0, t].map(f64::to_bits), general(tau), "tau = {tau:e}");
+            }
         }
     }
 }
