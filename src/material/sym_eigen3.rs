@@ -259,7 +259,12 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let mut taus = vec![SMALL_ROTATION_TAU, SMALL_ROTATION_TAU.next_up(), 1e20, 1e150];
+        let mut taus = vec![
+            SMALL_ROTATION_TAU,
+            SMALL_ROTATION_TAU.next_up(),
+            1e20,
+            1e150,
+        ];
         for _ in 0..200_000 {
             // Mantissas in [1, 2), exponents 27..=300.
             taus.push((1.0 + rnd()) * 2f64.powi(27 + (rnd() * 274.0) as i32));

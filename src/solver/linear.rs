@@ -40,6 +40,11 @@ pub trait LinearSolver {
 
     /// Number of symbolic analyses done (one per sparsity pattern, not per call).
     fn symbolic_analyses(&self) -> usize;
+
+    /// Whether a factorization without pivoting that refuses a system may hand it to a
+    /// pivoting one (on by default). Off, such a call fails instead: for a system that is
+    /// only tried, such as a status prediction's re-solve.
+    fn set_pivoting_fallback(&mut self, _allowed: bool) {}
 }
 
 /// A factorization that solves several right-hand sides at once: what the bordered solve
@@ -77,6 +82,7 @@ fn solve_bordered_in<F: Factorization>(
     a: &SparseMatrix,
     b: &mut [f64],
     border: &[usize],
+    configure: impl FnOnce(&mut F),
 ) -> Result<usize> {
     if b.len() != a.pattern.n {
         return Err(Error::LinearSolver(format!(
@@ -93,6 +99,7 @@ fn solve_bordered_in<F: Factorization>(
         *slot = Some(Box::new(BorderedSystem::new(&a.pattern, border)?));
     }
     let system = slot.as_mut().expect("set above");
+    configure(&mut system.inner);
     let before = system.inner.symbolic_count();
     let result = system.solve(a, b);
     result.map(|()| system.inner.symbolic_count() - before)
@@ -205,7 +212,7 @@ impl LinearSolver for FaerLu {
         if border.is_empty() {
             return self.factor_and_solve(a, b, 1);
         }
-        self.symbolic_count += solve_bordered_in(&mut self.border, a, b, border)?;
+        self.symbolic_count += solve_bordered_in(&mut self.border, a, b, border, |_| ())?;
         Ok(())
     }
 
@@ -240,6 +247,9 @@ pub struct SymmetricLu {
     /// system with every multiplier kept, then costs one factorization per call, not two).
     failures_in_a_row: usize,
     skip: usize,
+    /// Refused systems fail instead of going to the pivoting LU
+    /// ([`LinearSolver::set_pivoting_fallback`]).
+    no_fallback: bool,
 }
 
 /// See [`SymmetricLu::failures_in_a_row`].
@@ -309,6 +319,14 @@ impl Factorization for SymmetricLu {
     fn factor_and_solve(&mut self, a: &SparseMatrix, rhs: &mut [f64], nrhs: usize) -> Result<()> {
         check_system(a, rhs, nrhs)?;
         let original = rhs.to_vec();
+        if self.no_fallback {
+            return match self.try_without_pivoting(a, rhs, nrhs, &original)? {
+                true => Ok(()),
+                false => Err(Error::LinearSolver(
+                    "a pivot or the backward error was refused (no pivoting fallback)".into(),
+                )),
+            };
+        }
         if self.skip > 0 {
             self.skip -= 1;
         } else if self.try_without_pivoting(a, rhs, nrhs, &original)? {
@@ -332,12 +350,19 @@ impl LinearSolver for SymmetricLu {
         if border.is_empty() {
             return self.factor_and_solve(a, b, 1);
         }
-        self.symbolic_count += solve_bordered_in(&mut self.border, a, b, border)?;
+        let no_fallback = self.no_fallback;
+        self.symbolic_count += solve_bordered_in(&mut self.border, a, b, border, |inner| {
+            inner.no_fallback = no_fallback
+        })?;
         Ok(())
     }
 
     fn symbolic_analyses(&self) -> usize {
         Factorization::symbolic_count(self)
+    }
+
+    fn set_pivoting_fallback(&mut self, allowed: bool) {
+        self.no_fallback = !allowed;
     }
 }
 
@@ -406,6 +431,12 @@ impl LinearSolver for Solver {
         match self {
             Solver::SymmetricLu(s) => s.symbolic_analyses(),
             Solver::Lu(s) => s.symbolic_analyses(),
+        }
+    }
+
+    fn set_pivoting_fallback(&mut self, allowed: bool) {
+        if let Solver::SymmetricLu(s) = self {
+            s.set_pivoting_fallback(allowed);
         }
     }
 }
