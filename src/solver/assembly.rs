@@ -348,10 +348,9 @@ impl IncrementContext<'_> {
     /// accepted line-search cut needs no second evaluation: the element tangents (the
     /// kernel run again with its tangent: the same point states) and their assembly, and
     /// the contact blocks from the operator outputs `eval` already holds (no projection,
-    /// no operator). The result equals [`Self::evaluate`] at `x`, bit for bit: the same
-    /// additions in the same order. A model with a force-controlled tool is evaluated
-    /// again in full (its rows are few and placed by search); an `eval` that already has
-    /// its Jacobian is returned as it is.
+    /// no operator), and the force-controlled tools' rows from them too. The result equals
+    /// [`Self::evaluate`] at `x`, bit for bit: the same additions in the same order. An
+    /// `eval` that already has its Jacobian is returned as it is.
     pub fn complete(
         &self,
         x: &[f64],
@@ -360,9 +359,6 @@ impl IncrementContext<'_> {
     ) -> Result<Evaluation> {
         if eval.has_jacobian() {
             return Ok(eval);
-        }
-        if self.dofs.tool_offset.iter().any(Option::is_some) {
-            return self.evaluate(x, times);
         }
         times.jacobian_completions += 1;
         let model = self.model;
@@ -414,6 +410,19 @@ impl IncrementContext<'_> {
                 }
             }
         }
+        // The force (or approach) rows of force-controlled tools, in `with_contact`'s
+        // order; their residual is already in `eval` (the scratch copy is discarded).
+        let mut scratch = vec![0.0; self.dofs.n_dofs];
+        force_control::add_force_rows(
+            model,
+            self.dofs,
+            self.time,
+            x,
+            &eval.nodal,
+            &slots.force_control,
+            &mut scratch,
+            &mut jac,
+        )?;
         jac.set_unit_rows(&unit);
         times.contact += t1.elapsed().as_secs_f64();
         Ok(Evaluation {
@@ -904,9 +913,8 @@ mod tests {
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             let full = ctx.evaluate(&x, &mut times).unwrap();
             let residual_only = ctx.evaluate_residual(&x, &mut times).unwrap();
-            // Completed with its Jacobian: the full evaluation, bit for bit (the
-            // force-controlled model is evaluated again in full, the other completed
-            // without a contact pass).
+            // Completed with its Jacobian: the full evaluation, bit for bit, without a
+            // contact pass (the force-controlled model's force rows included).
             let completions = times.jacobian_completions;
             let completed = ctx
                 .complete(
@@ -915,10 +923,7 @@ mod tests {
                     &mut times,
                 )
                 .unwrap();
-            assert_eq!(
-                times.jacobian_completions,
-                completions + usize::from(!force_controlled)
-            );
+            assert_eq!(times.jacobian_completions, completions + 1);
             assert_eq!(
                 bits(&completed.jacobian.values),
                 bits(&full.jacobian.values)
