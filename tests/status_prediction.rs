@@ -156,3 +156,44 @@ fn prediction_keeps_the_first_contact_of_the_cylindrical_cup() {
         );
     }
 }
+
+/// The run's one warning about contact-status cycling suggests status prediction where it
+/// is off, and not where it is on (the cylindrical cup's first increment cycles either way).
+#[test]
+fn the_cycling_warning_suggests_prediction_only_where_it_is_off() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let source = std::fs::read_to_string(root.join("scripts/cylindrical_cup.rhai")).unwrap();
+    let marker = "max_cutbacks: max_cutbacks, max_iterations: max_iterations";
+    assert!(source.contains(marker));
+    for prediction in [0, 8] {
+        let out = out_dir(&format!("warning_{prediction}"));
+        let folder = out.with_extension("script");
+        std::fs::create_dir_all(&folder).unwrap();
+        let copy = folder.join("cylindrical_cup.rhai");
+        let edited = source.replace(
+            marker,
+            &format!("{marker}, status_prediction: {prediction}"),
+        );
+        std::fs::write(&copy, edited).unwrap();
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
+            .arg("run")
+            .arg(&copy)
+            .args(["--set", "charts=false", "--set", "travel=0.125"])
+            .args(["--set", "step=0.125", "--out"])
+            .arg(&out)
+            .output()
+            .expect("tribo runs");
+        let _ = std::fs::remove_dir_all(&folder);
+        let _ = std::fs::remove_dir_all(&out);
+        assert!(output.status.success());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        let text = format!("{stdout}{stderr}");
+        assert!(text.contains("changes back and forth"), "{text}");
+        assert_eq!(
+            text.contains("status_prediction: 8"),
+            prediction == 0,
+            "prediction {prediction}: {text}"
+        );
+    }
+}

@@ -848,11 +848,16 @@ fn cycling_warning(
     format!(
         "from increment {increment} on, the contact status of some barely touching nodes changes back and forth during Newton's iterations (here {} node(s): {}{}). \
          Each increment is still accepted only when the unmodified friction law holds to the Newton tolerances, so the results are sound; cycling costs iterations. \
-         If increments take many iterations or are cut back, try smaller increments (increments, or step_control: \"adaptive\"){}. \
+         If increments take many iterations or are cut back, try smaller increments (increments, or step_control: \"adaptive\"){}{}. \
          Not repeated: the count per increment is the column cycling_nodes of history.csv.",
         cycling.len(),
         nodes.join(", "),
         if more > 0 { format!(" and {more} more") } else { String::new() },
+        if model.settings.status_prediction == 0 {
+            ", status_prediction: 8 (each Newton step solved again with the nodes it carries into or out of touch linearised on their new status: fewer iterations, one more linear solve per re-solve; docs/convergence.md)"
+        } else {
+            ""
+        },
         match treatment {
             super::step_control::AntiCycling::Off => ", or anti_cycling: \"freeze\"",
             _ => "",
