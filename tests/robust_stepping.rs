@@ -460,6 +460,8 @@ fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
 
 /// When the increment cannot be completed at the minimum step the run stops with the
 /// reason and the nodes where the residual is largest; the committed state is untouched.
+/// The failed attempts' work is in the run's phase times and evaluation counts (nothing was
+/// accepted, so before they were counted these were zero).
 #[test]
 fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
     let mut model = adaptive_drag();
@@ -477,6 +479,11 @@ fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
     assert_eq!(sim.time(), 0.0);
     assert!(sim.displacements().iter().all(|&u| u == 0.0));
     assert!(sim.history.is_empty());
+    let spent = &sim.phase_times;
+    assert!(
+        spent.full_evaluations >= 2 && spent.elements > 0.0 && spent.factorization_and_solve > 0.0,
+        "failed attempts not accounted: {spent:?}"
+    );
 }
 
 /// Fixed stepping: each history row counts the cutbacks made before it was reached, so the

@@ -97,9 +97,9 @@ pub struct Measurement {
     /// Trial states evaluated per Newton iteration, (iterations + cuts) / iterations: the
     /// full step and each cut (predictors and re-evaluations not counted).
     pub trials_per_iteration: f64,
-    /// Element evaluations per Newton iteration, full (with tangents) and residual-only,
-    /// from the run's own count (`evaluations` in summary.json; None for a binary that does
-    /// not record it).
+    /// Element evaluations per accepted Newton iteration, full (with tangents) and
+    /// residual-only, from the run's own count (`evaluations` in summary.json, failed
+    /// attempts included; None for a binary that does not record it).
     pub full_evaluations_per_iteration: Option<f64>,
     pub residual_evaluations_per_iteration: Option<f64>,
     /// Residual-only evaluations later given their Jacobian (an accepted line-search cut:
@@ -548,9 +548,10 @@ fn table(result: &CaseResult) -> String {
         }
         s += "\n";
     }
-    s += "evals/it f+r+c: element evaluations per Newton iteration, full (with tangents) + \
-          residual-only (line-search trials) + completed (residual-only ones given their \
-          Jacobian afterwards: an accepted cut)\n";
+    s += "evals/it f+r+c: element evaluations per accepted Newton iteration, full (with \
+          tangents) + residual-only (line-search trials) + completed (residual-only ones given \
+          their Jacobian afterwards: an accepted cut); evaluations and phase seconds include \
+          the attempts that failed and were cut back\n";
     s
 }
 

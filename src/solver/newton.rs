@@ -230,6 +230,7 @@ impl Simulation {
         linear: &mut dyn LinearSolver,
         prediction: usize,
         max_iterations: usize,
+        times: &mut PhaseTimes,
     ) -> Result<Trial> {
         let mut settings = self.model.settings.clone();
         settings.status_prediction = prediction;
@@ -268,7 +269,6 @@ impl Simulation {
             .collect();
         let mut monitor = CyclingMonitor::new(&sizes, step.anti_cycling, step.cycle_flips);
         let node_of = |c: usize, k: usize| self.model.contacts[c].candidates[k];
-        let mut times = PhaseTimes::default();
         let unextrapolated = (settings.extrapolate && self.last_step.is_some()).then(|| x.clone());
         if settings.extrapolate {
             self.extrapolate(t_new, &mut x);
@@ -281,8 +281,8 @@ impl Simulation {
             "at the first iterate"
         };
         let mut eval = self
-            .start_iterate(&ctx, t_new, &mut x, linear, &mut times)
-            .and_then(|()| ctx.evaluate(&x, &mut times))
+            .start_iterate(&ctx, t_new, &mut x, linear, times)
+            .and_then(|()| ctx.evaluate(&x, times))
             .map_err(|err| crate::element::prefix(err, first))?;
         // The extrapolated start is a guess that the increment continues the last one's
         // motion. Where it does not (a rotating thin beam: continued linearly, a rotation
@@ -294,20 +294,20 @@ impl Simulation {
         // extrapolated start is the better one by far: a tool moved without the sheet
         // penetrates it).
         if let Some(mut plain) = unextrapolated {
-            self.start_iterate(&ctx, t_new, &mut plain, linear, &mut times)?;
+            self.start_iterate(&ctx, t_new, &mut plain, linear, times)?;
             let merit_of = |e: &Evaluation| self.residual_record(e, &weights).1;
             let extrapolated = merit_of(&eval);
             let committed = ctx
-                .evaluate_residual(&plain, &mut times)
+                .evaluate_residual(&plain, times)
                 .map(|e| merit_of(&e))
                 .unwrap_or(f64::INFINITY);
             if !(extrapolated <= EXTRAPOLATION_GUARD * committed) && committed.is_finite() {
                 x = plain;
-                eval = ctx.evaluate(&x, &mut times)?;
+                eval = ctx.evaluate(&x, times)?;
             }
         }
         if self.seat_force_controlled_tools(&eval, &mut x) {
-            eval = ctx.evaluate(&x, &mut times)?;
+            eval = ctx.evaluate(&x, times)?;
         }
         let mut residuals = Vec::new();
         let mut statuses: Vec<Vec<ContactStatus>> = Vec::new();
@@ -325,7 +325,7 @@ impl Simulation {
             self.check_interrupt()?;
             if monitor.observe(|c, k| eval.nodal[c][k].0.status) {
                 ctx.forced = monitor.forced();
-                eval = ctx.evaluate(&x, &mut times)?;
+                eval = ctx.evaluate(&x, times)?;
                 window_start = merits.len();
                 next_step = None;
             }
@@ -362,7 +362,7 @@ impl Simulation {
                     releases += 1;
                     monitor.release(releases < MAX_RELEASES);
                     ctx.forced = None;
-                    eval = ctx.evaluate(&x, &mut times)?;
+                    eval = ctx.evaluate(&x, times)?;
                     window_start = merits.len();
                     next_step = None;
                     continue;
@@ -416,7 +416,7 @@ impl Simulation {
                     &eval,
                     dx,
                     linear,
-                    &mut times,
+                    times,
                     settings.status_prediction,
                 )?
             } else {
@@ -445,7 +445,7 @@ impl Simulation {
                     contraction_time += ts.elapsed().as_secs_f64();
                     Ok(contracted.is_some())
                 },
-                &mut times,
+                times,
             )?;
             times.factorization_and_solve += contraction_time;
             // A full step accepted by the contraction test may raise |R|: the merits
@@ -465,7 +465,7 @@ impl Simulation {
             eval,
             iterations,
             residuals,
-            times,
+            times: *times,
             cycling: monitor.report(node_of),
             line_search_cuts,
         })

@@ -100,6 +100,8 @@ pub struct Simulation {
     pub(super) time: f64,
     pub(super) increments_done: usize,
     pub history: Vec<IncrementReport>,
+    /// Time and evaluations of every attempt so far: accepted increments, and the attempts
+    /// that failed (cut back) or that adaptive stepping rejected.
     pub phase_times: PhaseTimes,
     pub(super) energy: EnergyBalance,
     pub(super) energy_memory: EnergyMemory,
@@ -440,6 +442,7 @@ impl Simulation {
                         .controller
                         .assess(&step, end, dt_used, &measures, trial.iterations);
                     if !verdict.accept {
+                        self.phase_times.add(&trial.times);
                         rejected += 1;
                         dt = verdict.next_dt;
                         continue;
@@ -587,7 +590,10 @@ impl Simulation {
         let mut linear = std::mem::take(&mut self.linear);
         let prediction = self.model.settings.status_prediction;
         let budget = self.model.settings.max_iterations;
-        let mut outcome = self.newton(t_new, &mut linear, prediction, budget);
+        // Every attempt's time is the run's: a failed one's is counted here, an accepted
+        // one's (with a failed predicted attempt before its plain retry) when committed.
+        let mut spent = PhaseTimes::default();
+        let mut outcome = self.newton(t_new, &mut linear, prediction, budget, &mut spent);
         // A re-solved step can lead far off where many nodes change status at once (no
         // merit check guards it, see `status_prediction`), and the increment then fails
         // where the plain Newton would not: it is tried once more, plainly, before any
@@ -596,7 +602,16 @@ impl Simulation {
         // Newton cannot converge either (it cycles on the solid-shell cup), a retry with
         // the whole budget cost more than the cutback it was meant to avoid.
         if prediction > 0 && matches!(&outcome, Err(e) if retryable(e)) {
-            outcome = self.newton(t_new, &mut linear, 0, budget.min(PLAIN_RETRY_ITERATIONS));
+            outcome = self.newton(
+                t_new,
+                &mut linear,
+                0,
+                budget.min(PLAIN_RETRY_ITERATIONS),
+                &mut spent,
+            );
+        }
+        if outcome.is_err() {
+            self.phase_times.add(&spent);
         }
         self.linear = linear;
         outcome
