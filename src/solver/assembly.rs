@@ -411,8 +411,7 @@ impl IncrementContext<'_> {
             }
         }
         // The force (or approach) rows of force-controlled tools, in `with_contact`'s
-        // order; their residual is already in `eval` (the scratch copy is discarded).
-        let mut scratch = vec![0.0; self.dofs.n_dofs];
+        // order; their residual is already in `eval`.
         force_control::add_force_rows(
             model,
             self.dofs,
@@ -420,8 +419,8 @@ impl IncrementContext<'_> {
             x,
             &eval.nodal,
             &slots.force_control,
-            &mut scratch,
-            &mut jac,
+            None,
+            Some(&mut jac.values),
         )?;
         jac.set_unit_rows(&unit);
         times.contact += t1.elapsed().as_secs_f64();
@@ -526,10 +525,7 @@ impl IncrementContext<'_> {
     ) -> Result<ElementPart> {
         let model = self.model;
         let mut f_int = vec![0.0; 3 * self.dofs.n_nodes];
-        // Force-controlled tools add their rows through `SparseMatrix::add` (outside this
-        // module), so a residual-only evaluation still gives them a matrix to write into.
-        let force_controlled = self.dofs.tool_offset.iter().any(Option::is_some);
-        let mut jac = if with_jacobian || force_controlled {
+        let mut jac = if with_jacobian {
             SparseMatrix::zeros(self.pattern.clone())
         } else {
             SparseMatrix {
@@ -690,8 +686,8 @@ impl IncrementContext<'_> {
             x,
             &nodal,
             &slots.force_control,
-            &mut residual,
-            &mut jac,
+            Some(&mut residual),
+            with_jacobian.then_some(&mut jac.values[..]),
         )?;
         times.contact += t1.elapsed().as_secs_f64();
 

@@ -39,7 +39,6 @@
 use super::assembly::DofMap;
 use super::model::Model;
 use super::slots::ForceControlSlots;
-use super::sparse::SparseMatrix;
 use crate::contact::{Enforcement, NodalContact};
 use crate::geometry::{Projection, Vec3};
 use crate::tool::Pose;
@@ -177,8 +176,10 @@ pub fn row_scale(model: &Model, c: usize) -> f64 {
 }
 
 /// Adds the force equation of every force-controlled tool (or its approach equation when
-/// the tool touches nothing) at time `time`. `nodal` is the evaluation's per-node output;
-/// the Jacobian entries go to their precomputed positions `slots` (per tool).
+/// the tool touches nothing) at time `time`: its residual into `residual` and its Jacobian
+/// entries into the matrix values `jac`, at their precomputed positions `slots` (per tool),
+/// each only where given (a residual-only evaluation has no matrix; completing one
+/// with its Jacobian needs no residual). `nodal` is the evaluation's per-node output.
 #[allow(clippy::too_many_arguments)]
 pub fn add_force_rows(
     model: &Model,
@@ -187,8 +188,8 @@ pub fn add_force_rows(
     x: &[f64],
     nodal: &[Vec<(NodalContact, Option<Projection>)>],
     slots: &[Option<ForceControlSlots>],
-    residual: &mut [f64],
-    jac: &mut SparseMatrix,
+    mut residual: Option<&mut [f64]>,
+    mut jac: Option<&mut [f64]>,
 ) -> Result<()> {
     for (c, contact) in model.contacts.iter().enumerate() {
         let (Some(s), Some(off), Some(fc), Some(fs)) = (
@@ -206,11 +207,15 @@ pub fn add_force_rows(
                 let l = off + 3 * k;
                 let lambda = Vec3::new(x[l], x[l + 1], x[l + 2]);
                 pushed -= fc.axis.dot(&lambda);
-                for j in 0..3 {
-                    jac.values[fs.row[k][j]] += -fc.axis[j] / r_s;
+                if let Some(jac) = jac.as_deref_mut() {
+                    for j in 0..3 {
+                        jac[fs.row[k][j]] += -fc.axis[j] / r_s;
+                    }
                 }
             }
-            residual[s] = (pushed - fc.force.value(time)) / r_s;
+            if let Some(residual) = residual.as_deref_mut() {
+                residual[s] = (pushed - fc.force.value(time)) / r_s;
+            }
         } else {
             let travel = approach_travel(model, c, nodal).ok_or_else(|| {
                 Error::NoConvergence(format!(
@@ -218,8 +223,12 @@ pub fn add_force_rows(
                     contact.tool.name, fc.axis.x, fc.axis.y, fc.axis.z
                 ))
             })?;
-            residual[s] = -travel;
-            jac.values[fs.diagonal] += 1.0;
+            if let Some(residual) = residual.as_deref_mut() {
+                residual[s] = -travel;
+            }
+            if let Some(jac) = jac.as_deref_mut() {
+                jac[fs.diagonal] += 1.0;
+            }
         }
     }
     Ok(())
