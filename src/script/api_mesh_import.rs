@@ -200,14 +200,12 @@ fn register_files(engine: &mut Engine, policy: Rc<ReadPolicy>, limits: super::li
     });
 }
 
-fn names<'a>(it: impl Iterator<Item = &'a str>) -> Array {
-    it.map(|s| Dynamic::from(s.to_string())).collect()
-}
-
 fn register_set_names(engine: &mut Engine) {
-    engine.register_get("node_sets", |m: &mut Mesh| names(m.node_set_names()));
-    engine.register_get("element_sets", |m: &mut Mesh| names(m.element_set_names()));
-    engine.register_get("face_sets", |m: &mut Mesh| names(m.face_set_names()));
+    engine.register_get("node_sets", |m: &mut Mesh| strings(m.node_set_names()));
+    engine.register_get("element_sets", |m: &mut Mesh| {
+        strings(m.element_set_names())
+    });
+    engine.register_get("face_sets", |m: &mut Mesh| strings(m.face_set_names()));
     engine.register_fn(
         "element_set",
         |m: &mut Mesh, name: &str| -> ScriptResult<Array> {

@@ -517,12 +517,7 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     m.insert("cutbacks".into(), Dynamic::from(r.cutbacks as i64));
     m.insert(
         "cutback_reasons".into(),
-        Dynamic::from(
-            r.cutback_reasons
-                .iter()
-                .map(|why| Dynamic::from(why.clone()))
-                .collect::<Array>(),
-        ),
+        Dynamic::from(strings(r.cutback_reasons.iter().map(String::as_str))),
     );
     m.insert("dt".into(), Dynamic::from(r.dt));
     m.insert("rejected_steps".into(), Dynamic::from(r.rejected as i64));
@@ -541,12 +536,7 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     );
     m.insert(
         "warnings".into(),
-        Dynamic::from(
-            r.warnings
-                .iter()
-                .map(|w| Dynamic::from(w.clone()))
-                .collect::<Array>(),
-        ),
+        Dynamic::from(strings(r.warnings.iter().map(String::as_str))),
     );
     m.insert("active_nodes".into(), Dynamic::from(r.active_nodes as i64));
     m.insert(

@@ -44,6 +44,13 @@ pub fn vec3(a: &Array, what: &str) -> ScriptResult<Vec3> {
     ))
 }
 
+/// A script array of strings.
+pub fn strings<'a>(it: impl IntoIterator<Item = &'a str>) -> Array {
+    it.into_iter()
+        .map(|s| Dynamic::from(s.to_string()))
+        .collect()
+}
+
 pub fn array3(v: &Vec3) -> Array {
     vec![Dynamic::from(v.x), Dynamic::from(v.y), Dynamic::from(v.z)]
 }
