@@ -321,15 +321,17 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
 }
 
 /// High friction (mu = 0.5), oblique drag of a small ball, full Newton steps: a node at the
-/// edge of the contact cycles between stick and slip. Without the treatment Newton
-/// diverges; freezing the node's status converges in a few iterations, the node is named in
-/// the report and history.csv. The frozen state is then released and Newton finishes with
-/// the free law, so the accepted state satisfies it to the Newton tolerances.
+/// edge of the contact cycles between stick and slip. Without the treatment the plain
+/// Newton (no status prediction) diverges; freezing the node's status converges in a few
+/// iterations, the node is named in the report and history.csv. The frozen state is then
+/// released and Newton finishes with the free law, so the accepted state satisfies it to
+/// the Newton tolerances. Status prediction (the engine's default) gets through without
+/// anti-cycling too.
 #[test]
 fn anti_cycling_makes_a_high_friction_drag_converge() {
     let script = robust_script("high_friction_drag.rhai");
-    let run_with = |mode: &str, line_search: bool| {
-        let dir = out_dir(&format!("cycling-{mode}-{line_search}"));
+    let run_predicted = |mode: &str, line_search: bool, rounds: usize| {
+        let dir = out_dir(&format!("cycling-{mode}-{line_search}-{rounds}"));
         let host = HostOptions {
             out_dir: dir.clone(),
             ..HostOptions::default()
@@ -337,9 +339,11 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
         let sets = [
             script::parse_override(&format!("anti_cycling={mode}")).unwrap(),
             script::parse_override(&format!("line_search={line_search}")).unwrap(),
+            script::parse_override(&format!("status_prediction={rounds}")).unwrap(),
         ];
         (script::run_file(&script, &sets, &host), dir)
     };
+    let run_with = |mode: &str, line_search: bool| run_predicted(mode, line_search, 0);
     let run = |mode: &str| run_with(mode, false);
     let (off, off_dir) = run("off");
     let err = off.unwrap_err().to_string();
@@ -365,9 +369,21 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
         history_column(&searched_dir, "newton_iterations"),
         history_column(&searched_dir, "line_search_cuts")
     );
+    // Status prediction alone, full steps: the cycling node is linearised on the status
+    // the step carries it into.
+    let (predicted, predicted_dir) = run_predicted("off", false, 8);
+    predicted.unwrap();
+    let iterations = history_column(&predicted_dir, "newton_iterations");
+    println!("status prediction, no anti-cycling: iterations {iterations:?}");
+    assert_eq!(iterations.len(), 4, "no cutback");
+    assert!(
+        iterations.iter().all(|&i| i <= 12.0),
+        "converges in a few iterations: {iterations:?}"
+    );
     let _ = std::fs::remove_dir_all(&off_dir);
     let _ = std::fs::remove_dir_all(&on_dir);
     let _ = std::fs::remove_dir_all(&searched_dir);
+    let _ = std::fs::remove_dir_all(&predicted_dir);
 }
 
 /// The REPL steps, rolls back to the previous converged increment, switches to adaptive
@@ -465,8 +481,11 @@ fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
 #[test]
 fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
     let mut model = adaptive_drag();
-    // One Newton iteration cannot converge a contact increment; dt cannot be cut below 0.4.
+    // One plain Newton iteration cannot converge a contact increment; dt cannot be cut
+    // below 0.4. (With status prediction one iteration does converge it at dt = 0.4: the
+    // predicted statuses are this drag's.)
     model.settings.max_iterations = 1;
+    model.settings.status_prediction = 0;
     model.settings.stepping.dt_min = Some(0.4);
     let mut sim = Simulation::new(model).unwrap();
     let err = sim.step().unwrap_err().to_string();
