@@ -20,7 +20,12 @@ pub const CHECK_EVERY: u64 = 64;
 /// Measured peak resident memory per mesh node of a run (assembled tangent, its
 /// factorisation, contact data): 63 KB/node for the thin square-cup blank, 80-84 KB/node for
 /// the thick cylinder-drag block (scripts/cylinder_drag.rhai with cells = 96 and 128, peak RSS
-/// 385 and 712 MB for 4 850 and 8 514 nodes); 100 KB leaves a margin.
+/// 385 and 712 MB for 4 850 and 8 514 nodes); 100 KB leaves a margin. With status prediction
+/// on (the default since session 27; it keeps the element tangents for its re-solves): the
+/// cylinder drag 180 and 294 MB (cells = 96, 128), the 25 x 25 x 1 cup 101-121 MiB for
+/// 1 352 nodes (plain 80-90), the 50 x 50 x 2 cup 616 MiB (paper) and 721 MiB (benchmark)
+/// for 7 803 nodes: 94 KB/node, the nearest to the estimate (not raised: finer meshes were
+/// not measured with prediction).
 pub const BYTES_PER_NODE: u64 = 100_000;
 /// Resident memory of the process before any mesh.
 pub const BASE_BYTES: u64 = 20 << 20;
