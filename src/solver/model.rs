@@ -44,16 +44,16 @@ pub struct ToolContact {
     pub r: Vec<f64>,
 }
 
-/// Status-prediction re-solves per Newton step by default: 8. They more than halve the
-/// iterations of the 25 x 25 x 1 square cup, which then meets issue 14's cup targets under
-/// the default budget (the plain Newton does not finish the paper cup under it), at 0.87
-/// times the plain Newton's CPU over the whole paper cup (docs/convergence.md). The blocker
-/// of earlier sessions, a frictional first contact converging to another of its states
-/// (the cylindrical cup's first increment), came from pivoting solves of nearly singular
-/// predicted systems, which re-solves no longer do. Cost where prediction fails: an
-/// attempt that does not converge with it is tried again plainly before a cutback (the
-/// U-channel scene takes 2.5-2.7 times the plain CPU, and stays under 25 iterations per
-/// increment where the plain Newton took 26 and 30).
+/// Status-prediction re-solves per Newton step by default: 8. They take 42-50 % fewer
+/// iterations over the whole 25 x 25 x 1 square cups (on the paper cup's first 3 mm: 43
+/// against 129), which then meet issue 14's cup targets under the default budget (the plain
+/// Newton does not finish the paper cup under it), at 0.86-0.87 times the plain Newton's
+/// CPU (docs/convergence.md). The blocker of earlier sessions, a frictional first contact
+/// converging to another of its states (the cylindrical cup's first increment), came from
+/// pivoting solves of nearly singular predicted systems, which re-solves no longer do. Cost
+/// where prediction fails: an attempt that does not converge with it is tried again
+/// plainly before a cutback (the U-channel scene takes 2.6-2.9 times the plain CPU, and
+/// stays under 25 iterations per increment where the plain Newton took 26 and 30).
 pub const DEFAULT_STATUS_PREDICTION: usize = 8;
 
 /// Newton and stepping settings.
