@@ -34,7 +34,9 @@ fn condensed_newton_step_equals_the_mixed_one() {
 
 /// The slot plan places every contribution where a search in the pattern would: the reduced
 /// matrix and right-hand side are bitwise those of the search-based construction (same
-/// contributions, summed in the same order).
+/// contributions, summed in the same order). The plan skips the contributions of zero
+/// coefficients, which the search adds: only the sign of an entry that is exactly zero may
+/// differ (`+0 + -0 = +0`).
 #[test]
 fn slot_plan_builds_the_reduced_system_of_the_search() {
     let mut sim = drag(true);
@@ -54,7 +56,9 @@ fn slot_plan_builds_the_reduced_system_of_the_search() {
     assert!(a.values.iter().any(|v| *v != 0.0));
     assert_eq!(a.pattern, a_ref.pattern);
     for (k, (v, w)) in a.values.iter().zip(&a_ref.values).enumerate() {
-        assert_eq!(v.to_bits(), w.to_bits(), "value {k}: {v} vs {w}");
+        if *v != 0.0 || *w != 0.0 {
+            assert_eq!(v.to_bits(), w.to_bits(), "value {k}: {v} vs {w}");
+        }
     }
     for (k, (v, w)) in rhs.iter().zip(&rhs_ref).enumerate() {
         assert_eq!(v.to_bits(), w.to_bits(), "right-hand side {k}: {v} vs {w}");

@@ -456,7 +456,13 @@ impl IncrementContext<'_> {
             f_int: eval.f_int.clone(),
             trial_points: eval.trial_points.clone(),
         };
-        self.with_contact(x, part, times, true)
+        // The projections depend on x and the committed hints only: those of `eval`.
+        let projections: Vec<Vec<Option<Projection>>> = eval
+            .nodal
+            .iter()
+            .map(|list| list.iter().map(|(_, p)| p.clone()).collect())
+            .collect();
+        self.with_contact(x, part, times, true, Some(&projections))
     }
 
     /// The multiplier components `k` of a pair whose equation becomes `lambda_k = 0`: a
@@ -511,7 +517,7 @@ impl IncrementContext<'_> {
             times.residual_evaluations += 1;
         }
         let part = self.element_part(x, times, with_jacobian)?;
-        self.with_contact(x, part, times, with_jacobian)
+        self.with_contact(x, part, times, with_jacobian, None)
     }
 
     /// The elements at `x`: their assembled stiffness (when `with_jacobian`, or a
@@ -572,6 +578,7 @@ impl IncrementContext<'_> {
         part: ElementPart,
         times: &mut PhaseTimes,
         with_jacobian: bool,
+        projections: Option<&[Vec<Option<Projection>>]>,
     ) -> Result<Evaluation> {
         let model = self.model;
         let n = self.dofs.n_dofs;
@@ -620,7 +627,10 @@ impl IncrementContext<'_> {
                             hint: committed.hint.unwrap_or_default(),
                         }
                     }),
-                    None => contact.tool.project(pose, &xn, committed.hint.as_ref()),
+                    None => match projections {
+                        Some(known) => known[c][k].clone(),
+                        None => contact.tool.project(pose, &xn, committed.hint.as_ref()),
+                    },
                 };
                 let lam_dof = self.dofs.lambda_offset[c].map(|off| off + 3 * k);
                 let lambda = match lam_dof {

@@ -76,8 +76,18 @@ pub struct SymbolicSymmetricLu {
     updates: Vec<Update>,
     /// Value index of every entry of `A` (in `A`'s storage order).
     slot: Vec<usize>,
+    /// Supernode whose panels hold each entry of `A` (in `A`'s storage order).
+    entry_super: Vec<usize>,
+    /// Floating-point operations of each supernode's numeric step (its descendant updates,
+    /// its diagonal block and its triangular solves): what a partial refactorization saves.
+    flops: Vec<f64>,
     len: usize,
+    /// Identifies this analysis, so that numeric factors kept for a partial
+    /// refactorization are never reused on another one.
+    id: u64,
 }
+
+static NEXT_ANALYSIS_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl SymbolicSymmetricLu {
     /// AMD ordering and supernodal structure of `A + A^T`. O(nnz(L)) time and memory.
@@ -189,14 +199,36 @@ impl SymbolicSymmetricLu {
             offset,
             update_ptr,
             updates,
-            slot: Vec::with_capacity(pattern.nnz()),
+            slot: Vec::new(),
+            entry_super: Vec::new(),
+            flops: Vec::new(),
             len,
+            id: NEXT_ANALYSIS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         };
+        analysis.flops = (0..ns)
+            .map(|s| {
+                let (_, k, r, _) = analysis.panels(s);
+                let (k, r) = (k as f64, r as f64);
+                let own = 2.0 / 3.0 * k * k * k + 2.0 * r * k * k;
+                let updates = &analysis.updates[analysis.update_ptr[s]..analysis.update_ptr[s + 1]];
+                own + updates
+                    .iter()
+                    .map(|up| {
+                        let (_, kd, rd, _) = analysis.panels(up.d);
+                        let nc = (up.p2 - up.p1) as f64;
+                        let rows = ((rd - up.p1) + (rd - up.p2)) as f64;
+                        2.0 * rows * nc * kd as f64
+                    })
+                    .sum::<f64>()
+            })
+            .collect();
         let mut slot = Vec::with_capacity(pattern.nnz());
+        let mut entry_super = Vec::with_capacity(pattern.nnz());
         for c in 0..n {
             for &r in &pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]] {
                 let (pi, pj) = (inverse[r], inverse[c]);
                 let s = col_super[pi.min(pj)];
+                entry_super.push(s);
                 slot.push(analysis.slot_of(s, pi, pj).ok_or_else(|| {
                     Error::LinearSolver(format!(
                         "entry ({r}, {c}) outside the symbolic factor (internal error)"
@@ -205,6 +237,7 @@ impl SymbolicSymmetricLu {
             }
         }
         analysis.slot = slot;
+        analysis.entry_super = entry_super;
         Ok(analysis)
     }
 
@@ -332,23 +365,71 @@ pub struct NumericSymmetricLu {
     position: Vec<usize>,
     product: Vec<f64>,
     work: Vec<f64>,
+    /// The values of `A` that `values` are the complete factors of, and the analysis they
+    /// were computed on: a later call recomputes only what differs ([`Self::factorize`]).
+    factored: Vec<f64>,
+    factored_on: Option<u64>,
+    dirty: Vec<bool>,
+    /// Work of all calls and of the supernodes they recomputed (flops).
+    pub flops_total: f64,
+    pub flops_done: f64,
 }
 
 impl NumericSymmetricLu {
     /// Factorizes the matrix with values `a` on the analysed pattern.
+    ///
+    /// When the factors of the previous call are complete and on the same analysis, only
+    /// the supernodes that differ are recomputed: those owning an entry of `a` that
+    /// changed (bit for bit), and every supernode updated by a recomputed one (its
+    /// ancestors in the elimination tree). The others' panels depend on unchanged entries
+    /// only, so the factors are the ones a full factorization gives, bit for bit. A
+    /// re-solve that changes the rows of a few contact nodes (status prediction,
+    /// [`super::status_prediction`]) then pays for their paths to the root only.
     pub fn factorize(
         &mut self,
         symbolic: &SymbolicSymmetricLu,
         a: &[f64],
     ) -> std::result::Result<(), PivotFailure> {
         let sy = symbolic;
-        self.values.clear();
-        self.values.resize(sy.len, 0.0);
-        self.position.resize(sy.n, 0);
-        for (&v, &k) in a.iter().zip(&sy.slot) {
-            self.values[k] = v;
+        let ns = sy.begin.len() - 1;
+        let partial = self.factored_on == Some(sy.id) && self.factored.len() == a.len() && std::env::var_os("TRIBO_NO_PARTIAL_LU").is_none();
+        self.factored_on = None;
+        self.dirty.clear();
+        self.dirty.resize(ns, !partial);
+        if partial {
+            for ((&new, &old), &s) in a.iter().zip(&self.factored).zip(&sy.entry_super) {
+                if new.to_bits() != old.to_bits() {
+                    self.dirty[s] = true;
+                }
+            }
+            for s in 0..ns {
+                if !self.dirty[s] {
+                    let updates = &sy.updates[sy.update_ptr[s]..sy.update_ptr[s + 1]];
+                    self.dirty[s] = updates.iter().any(|up| self.dirty[up.d]);
+                }
+            }
+            for s in (0..ns).filter(|&s| self.dirty[s]) {
+                self.values[sy.offset[s]..sy.offset[s + 1]].fill(0.0);
+            }
+            for ((&v, &k), &s) in a.iter().zip(&sy.slot).zip(&sy.entry_super) {
+                if self.dirty[s] {
+                    self.values[k] = v;
+                }
+            }
+        } else {
+            self.values.clear();
+            self.values.resize(sy.len, 0.0);
+            for (&v, &k) in a.iter().zip(&sy.slot) {
+                self.values[k] = v;
+            }
         }
-        for s in 0..sy.begin.len() - 1 {
+        self.position.resize(sy.n, 0);
+        self.flops_total += sy.flops.iter().sum::<f64>();
+        for s in 0..ns {
+            if !self.dirty[s] {
+                continue;
+            }
+            self.flops_done += sy.flops[s];
             let (f, k, r, rows) = sy.panels(s);
             let m = k + r;
             for j in 0..k {
@@ -436,6 +517,12 @@ impl NumericSymmetricLu {
                 );
             }
         }
+        if std::env::var_os("TRIBO_PARTIAL_STATS").is_some() {
+            eprintln!("PARTIAL_LU {partial} flops done/total = {:.3e}/{:.3e} = {:.3}", self.flops_done, self.flops_total, self.flops_done / self.flops_total);
+        }
+        self.factored.clear();
+        self.factored.extend_from_slice(a);
+        self.factored_on = Some(sy.id);
         Ok(())
     }
 
@@ -763,5 +850,13 @@ mod tests {
         let mut nan = a.clone();
         nan.values[0] = f64::NAN;
         assert!(solver.solve(&nan, &mut [1.0, 2.0]).is_err());
+    }
+}
+
+impl Drop for NumericSymmetricLu {
+    fn drop(&mut self) {
+        if std::env::var_os("TRIBO_PARTIAL_STATS").is_some() && self.flops_total > 0.0 {
+            eprintln!("PARTIAL_LU flops done/total = {:.3e}/{:.3e} = {:.3}", self.flops_done, self.flops_total, self.flops_done / self.flops_total);
+        }
     }
 }
