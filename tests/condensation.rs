@@ -65,6 +65,72 @@ fn slot_plan_builds_the_reduced_system_of_the_search() {
     }
 }
 
+/// A reduced system built after another one rebuilds only the segments whose inputs
+/// changed and keeps the rest: it equals the search-based construction of its own
+/// Jacobian, after a change of one node's rows (a status prediction re-solve), after a
+/// change everywhere (the next Newton iterate) and after no change at all.
+#[test]
+fn a_reduced_system_built_after_another_equals_a_fresh_one() {
+    let mut sim = drag(true);
+    for _ in 0..6 {
+        sim.step().unwrap();
+    }
+    let t_new = sim.time() + 0.25;
+    let x = sim.unknowns().to_vec();
+    let e = sim.evaluate_at(t_new, &x).unwrap();
+    let condenser = sim.condenser().expect("multipliers are eliminated");
+    let mut one_node = e.jacobian.clone();
+    // The equilibrium row of the middle contact candidate (a row with a multiplier
+    // column), its entries scaled.
+    let n_u = sim.displacements().len();
+    let candidates: Vec<usize> = (0..n_u / 3)
+        .filter(|&n| {
+            (n_u..e.jacobian.pattern.n).any(|c| e.jacobian.pattern.position(3 * n, c).is_some())
+        })
+        .collect();
+    let node = candidates[candidates.len() / 2];
+    for c in 0..one_node.pattern.n {
+        if let Some(k) = one_node.pattern.position(3 * node, c) {
+            one_node.values[k] *= 1.25;
+        }
+    }
+    let mut x2 = x.clone();
+    x2.iter_mut()
+        .enumerate()
+        .for_each(|(i, v)| *v += 1e-4 * (i as f64).sin());
+    let e2 = sim.evaluate_at(t_new, &x2).unwrap();
+    let mut previous: Option<Vec<f64>> = None;
+    for (what, j, residual) in [
+        ("first", &e.jacobian, &e.residual),
+        ("one node's rows", &one_node, &e.residual),
+        ("the next iterate", &e2.jacobian, &e2.residual),
+        ("no change", &e2.jacobian, &e2.residual),
+    ] {
+        let (a, rhs) = condenser.reduced_system(j, residual).unwrap();
+        let (a_ref, rhs_ref) = condenser.reduced_system_by_search(j, residual).unwrap();
+        for (k, (v, w)) in a.values.iter().zip(&a_ref.values).enumerate() {
+            if *v != 0.0 || *w != 0.0 {
+                assert_eq!(v.to_bits(), w.to_bits(), "{what}: value {k}: {v} vs {w}");
+            }
+        }
+        for (k, (v, w)) in rhs.iter().zip(&rhs_ref).enumerate() {
+            assert_eq!(v.to_bits(), w.to_bits(), "{what}: right-hand side {k}");
+        }
+        if let Some(p) = &previous {
+            let changed = p.iter().zip(&a.values).filter(|(u, v)| u != v).count();
+            println!(
+                "{what}: {changed} of {} reduced entries changed",
+                a.values.len()
+            );
+            match what {
+                "no change" => assert_eq!(changed, 0),
+                _ => assert!(changed > 0, "{what}"),
+            }
+        }
+        previous = Some(a.values.clone());
+    }
+}
+
 #[test]
 fn condensed_and_mixed_runs_agree() {
     let mut a = drag(true);

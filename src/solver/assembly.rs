@@ -460,7 +460,7 @@ impl IncrementContext<'_> {
         let projections: Vec<Vec<Option<Projection>>> = eval
             .nodal
             .iter()
-            .map(|list| list.iter().map(|(_, p)| p.clone()).collect())
+            .map(|list| list.iter().map(|(_, p)| *p).collect())
             .collect();
         self.with_contact(x, part, times, true, Some(&projections))
     }
@@ -628,7 +628,7 @@ impl IncrementContext<'_> {
                         }
                     }),
                     None => match projections {
-                        Some(known) => known[c][k].clone(),
+                        Some(known) => known[c][k],
                         None => contact.tool.project(pose, &xn, committed.hint.as_ref()),
                     },
                 };

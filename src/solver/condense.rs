@@ -56,7 +56,15 @@ use super::model::Model;
 use super::sparse::{SparseMatrix, SparsePattern};
 use crate::Result;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
+
+/// A reduced matrix's values with the Jacobian values and coefficients it was built from.
+#[derive(Debug)]
+struct LastReduction {
+    jacobian: Vec<f64>,
+    coefficients: Vec<f64>,
+    values: Vec<f64>,
+}
 
 /// Elimination groups of the mixed unknowns (see `SparsePattern::groups`): a node's
 /// displacements and the multipliers of its contact pairs form one group (the node's
@@ -143,6 +151,12 @@ pub struct Condenser {
     /// The slot plan: the reduced matrix's value index of every contribution, in the order
     /// of [`Self::walk`] (u32: the reduced pattern has fewer than 2^32 entries).
     slots: Vec<u32>,
+    /// Where each segment of the walk starts in `slots` (and `slots.len()` at the end):
+    /// the kept rows in `kept_rows`' order, then the eliminated nodes.
+    segment_start: Vec<usize>,
+    kept_rows: Vec<usize>,
+    /// The last reduced matrix and what it was built from, for [`Self::reduced_with`].
+    last: Mutex<Option<LastReduction>>,
     /// The back-substitution's `N du` terms, (column, value position) of every kept column
     /// of each eliminated node's local rows, node after node and row after row (the
     /// entries of `rows` that are not eliminated multipliers, listed once instead of
@@ -305,6 +319,9 @@ impl Condenser {
             owner,
             slots: Vec::new(),
             reduced_len: Vec::new(),
+            segment_start: Vec::new(),
+            kept_rows: Vec::new(),
+            last: Mutex::new(None),
             back_terms: Vec::new(),
             back_ptr: vec![0],
             fallbacks: AtomicUsize::new(0),
@@ -336,9 +353,21 @@ impl Condenser {
         let mut plan = Recorder {
             pattern: condenser.pattern.clone(),
             slots: Vec::new(),
+            segment_start: Vec::new(),
         };
-        condenser.walk(&coefficients, &zeros, &vec![0.0; full.n], &mut rhs, &mut plan);
+        condenser.walk(
+            &coefficients,
+            &zeros,
+            &vec![0.0; full.n],
+            &mut rhs,
+            &mut plan,
+        );
+        plan.segment_start.push(plan.slots.len());
         condenser.slots = plan.slots;
+        condenser.segment_start = plan.segment_start;
+        condenser.kept_rows = (0..full.n)
+            .filter(|&r| condenser.reduced_index[r].is_some() && !condenser.condensed_row[r])
+            .collect();
         Some(condenser)
     }
 
@@ -434,7 +463,7 @@ impl Condenser {
         factor: f64,
     ) {
         let row = e.local_row(i);
-        if factor == 0.0 && sink.skips_zeros() {
+        if sink.skips(factor) {
             sink.skip(self.reduced_len[row]);
             return;
         }
@@ -451,9 +480,8 @@ impl Condenser {
     ///
     /// A local row whose coefficient is zero is skipped whole when the sink allows it: in
     /// a condensed row most coefficients are exact zeros (a node in gap keeps its
-    /// equilibrium rows, `P = [I 0]`; in stick only the pair's own rows count), and on the
-    /// cup, where every blank node is a contact candidate, those zeros were two thirds of
-    /// the contributions.
+    /// equilibrium rows, `P = [I 0]`; in stick only the pair's own rows count). A sink may
+    /// also skip whole segments whose inputs did not change ([`Replay`]).
     fn walk(
         &self,
         coefficients: &[f64],
@@ -463,6 +491,7 @@ impl Condenser {
         sink: &mut impl Contributions,
     ) {
         let n = self.rows.len();
+        let mut segment = 0;
         // Rows that stay as they are.
         for row in 0..n {
             let Some(ri) = self.reduced_index[row] else {
@@ -471,6 +500,8 @@ impl Condenser {
             if self.condensed_row[row] {
                 continue;
             }
+            sink.begin_segment(segment);
+            segment += 1;
             rhs[ri] = -residual[row];
             for &(col, k) in &self.rows[row] {
                 if let Some(ci) = self.reduced_index[col] {
@@ -489,6 +520,8 @@ impl Condenser {
         }
         // Condensed rows: P N du = P rhs_local.
         for e in &self.nodes {
+            sink.begin_segment(segment);
+            segment += 1;
             let w = e.width();
             for alpha in 0..3 {
                 let ri = self.reduced_index[3 * e.node + alpha].expect("displacements stay");
@@ -502,8 +535,12 @@ impl Condenser {
     }
 
     /// The reduced matrix and right-hand side, built by replaying the slot plan: one linear
-    /// pass over the contributions, no search. O(contributions) = O(nnz(J)) per call. `None`
-    /// when a node has two active pairs (no local elimination).
+    /// pass over the contributions, no search. After a first call, only the segments whose
+    /// Jacobian rows or node coefficients changed are replayed (a status prediction
+    /// re-solve changes a few nodes); the result is bit for bit a full replay's (but for the
+    /// sign of an exact zero). O(nnz(J)) per call to find what changed, then
+    /// O(contributions) of the changed segments. `None` when a node has two active pairs
+    /// (no local elimination).
     pub fn reduced_system(
         &self,
         j: &SparseMatrix,
@@ -519,16 +556,82 @@ impl Condenser {
         j: &SparseMatrix,
         residual: &[f64],
     ) -> (SparseMatrix, Vec<f64>) {
+        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        let dirty = last
+            .as_ref()
+            .filter(|l| l.jacobian.len() == j.values.len())
+            .map(|l| self.dirty_segments(l, j, coefficients));
         let mut a = SparseMatrix::zeros(self.pattern.clone());
+        if dirty.is_some() {
+            let kept = last
+                .as_ref()
+                .expect("dirty segments come from a last reduction");
+            a.values.copy_from_slice(&kept.values);
+        }
         let mut rhs = vec![0.0; self.pattern.n];
         let mut replay = Replay {
             slots: &self.slots,
+            segment_start: &self.segment_start,
+            dirty: dirty.as_deref(),
+            active: true,
             next: 0,
             values: &mut a.values,
         };
         self.walk(coefficients, &j.values, residual, &mut rhs, &mut replay);
-        debug_assert_eq!(replay.next, self.slots.len(), "the plan covers every contribution");
+        let kept = last.get_or_insert_with(|| LastReduction {
+            jacobian: Vec::new(),
+            coefficients: Vec::new(),
+            values: Vec::new(),
+        });
+        let keep = |to: &mut Vec<f64>, from: &[f64]| {
+            to.clear();
+            to.extend_from_slice(from);
+        };
+        keep(&mut kept.jacobian, &j.values);
+        keep(&mut kept.coefficients, coefficients);
+        keep(&mut kept.values, &a.values);
         (a, rhs)
+    }
+
+    /// The segments of the walk whose contributions differ from those of `last`: an
+    /// eliminated node whose coefficients or local rows changed, a kept row that changed or
+    /// has a column of such a node. Values are compared bit for bit.
+    fn dirty_segments(
+        &self,
+        last: &LastReduction,
+        j: &SparseMatrix,
+        coefficients: &[f64],
+    ) -> Vec<bool> {
+        let n = self.rows.len();
+        let mut row_changed = vec![false; n];
+        for (k, (new, old)) in j.values.iter().zip(&last.jacobian).enumerate() {
+            if new.to_bits() != old.to_bits() {
+                row_changed[j.pattern.row_idx[k]] = true;
+            }
+        }
+        let node_changed: Vec<bool> = self
+            .nodes
+            .iter()
+            .map(|e| {
+                let w = e.width();
+                let range = e.offset..e.offset + w * w;
+                (0..w).any(|i| row_changed[e.local_row(i)])
+                    || coefficients[range.clone()]
+                        .iter()
+                        .zip(&last.coefficients[range])
+                        .any(|(a, b)| a.to_bits() != b.to_bits())
+            })
+            .collect();
+        self.kept_rows
+            .iter()
+            .map(|&row| {
+                row_changed[row]
+                    || self.rows[row]
+                        .iter()
+                        .any(|&(col, _)| self.owner[col].is_some_and(|(e, _)| node_changed[e]))
+            })
+            .chain(node_changed.iter().copied())
+            .collect()
     }
 
     /// The same reduced system with every contribution placed by a binary search in the
@@ -543,7 +646,13 @@ impl Condenser {
         let coefficients = self.coefficients(&j.values).ok()?;
         let mut a = SparseMatrix::zeros(self.pattern.clone());
         let mut rhs = vec![0.0; self.pattern.n];
-        self.walk(&coefficients, &j.values, residual, &mut rhs, &mut Search(&mut a));
+        self.walk(
+            &coefficients,
+            &j.values,
+            residual,
+            &mut rhs,
+            &mut Search(&mut a),
+        );
         Some((a, rhs))
     }
 
@@ -605,22 +714,32 @@ impl Condenser {
 
 /// Where [`Condenser::walk`] puts the reduced matrix's contributions.
 trait Contributions {
+    /// The contributions that follow, up to the next call, form segment `index`: one
+    /// kept row, or one eliminated node's three condensed rows, in the walk's order.
+    fn begin_segment(&mut self, _index: usize) {}
     fn add(&mut self, row: usize, col: usize, value: f64);
-    /// Whether a run of zero contributions may be skipped (then [`Self::skip`] is called
-    /// with its length instead of `add` for each).
-    fn skips_zeros(&self) -> bool {
+    /// Whether the local row about to be added with `factor` may be skipped (then
+    /// [`Self::skip`] is called with its number of contributions instead of `add` for
+    /// each).
+    fn skips(&self, _factor: f64) -> bool {
         false
     }
     fn skip(&mut self, _count: usize) {}
 }
 
-/// Records the slot plan: the value index of every contribution.
+/// Records the slot plan: the value index of every contribution, and where each segment
+/// starts in it.
 struct Recorder {
     pattern: Arc<SparsePattern>,
     slots: Vec<u32>,
+    segment_start: Vec<usize>,
 }
 
 impl Contributions for Recorder {
+    fn begin_segment(&mut self, index: usize) {
+        debug_assert_eq!(index, self.segment_start.len());
+        self.segment_start.push(self.slots.len());
+    }
     fn add(&mut self, row: usize, col: usize, _value: f64) {
         let k = self
             .pattern
@@ -630,20 +749,36 @@ impl Contributions for Recorder {
     }
 }
 
-/// Replays the slot plan into the reduced matrix's values.
+/// Replays the slot plan into the reduced matrix's values: every segment into zeros, or,
+/// with `dirty`, only the dirty segments, each zeroed first (a reduced row receives the
+/// contributions of one segment only), the others' values kept.
 struct Replay<'a> {
     slots: &'a [u32],
+    segment_start: &'a [usize],
+    dirty: Option<&'a [bool]>,
+    active: bool,
     next: usize,
     values: &'a mut [f64],
 }
 
 impl Contributions for Replay<'_> {
+    fn begin_segment(&mut self, index: usize) {
+        self.next = self.segment_start[index];
+        self.active = self.dirty.is_none_or(|d| d[index]);
+        if self.active && self.dirty.is_some() {
+            for &k in &self.slots[self.next..self.segment_start[index + 1]] {
+                self.values[k as usize] = 0.0;
+            }
+        }
+    }
     fn add(&mut self, _row: usize, _col: usize, value: f64) {
-        self.values[self.slots[self.next] as usize] += value;
+        if self.active {
+            self.values[self.slots[self.next] as usize] += value;
+        }
         self.next += 1;
     }
-    fn skips_zeros(&self) -> bool {
-        true
+    fn skips(&self, factor: f64) -> bool {
+        factor == 0.0 || !self.active
     }
     fn skip(&mut self, count: usize) {
         self.next += count;

@@ -18,9 +18,13 @@
 //! branch the node is heading into. Only the step changes: the line search and the
 //! convergence test use the exact law, so the converged answer is the same.
 //!
-//! Cost per re-solve: the contact part of one evaluation (the element part at `x` is kept
-//! from the step's own evaluation, [`IncrementContext::relinearised`]) and one linear
-//! solve; the prediction itself is O(1) per contact pair.
+//! Cost per re-solve: the contact part of one evaluation (the element part and the tool
+//! projections at `x` are kept from the step's own evaluation,
+//! [`IncrementContext::relinearised`]) and one linear solve, whose factorization
+//! recomputes only the supernodes that the changed nodes' rows reach (their paths to the
+//! root of the elimination tree: 58-67 % of a whole factorization's flops on the 25 x 25 x 1
+//! cup, [`super::symmetric_lu::NumericSymmetricLu::factorize`]); the prediction itself is
+//! O(1) per contact pair.
 
 use super::assembly::{DofMap, Evaluation, IncrementContext, PhaseTimes};
 use super::linear::LinearSolver;
