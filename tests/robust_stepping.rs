@@ -348,7 +348,7 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
     let (off, off_dir) = run("off");
     let err = off.unwrap_err().to_string();
     println!("without anti-cycling: {err}");
-    assert!(err.contains("status cycling at node(s)"), "{err}");
+    assert!(err.contains("status cycling at"), "{err}");
     let (on, on_dir) = run("freeze");
     on.unwrap();
     let iterations = history_column(&on_dir, "newton_iterations");
