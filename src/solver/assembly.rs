@@ -457,12 +457,7 @@ impl IncrementContext<'_> {
             trial_points: eval.trial_points.clone(),
         };
         // The projections depend on x and the committed hints only: those of `eval`.
-        let projections: Vec<Vec<Option<Projection>>> = eval
-            .nodal
-            .iter()
-            .map(|list| list.iter().map(|(_, p)| *p).collect())
-            .collect();
-        self.with_contact(x, part, times, true, Some(&projections))
+        self.with_contact(x, part, times, true, Some(eval))
     }
 
     /// The multiplier components `k` of a pair whose equation becomes `lambda_k = 0`: a
@@ -578,7 +573,7 @@ impl IncrementContext<'_> {
         part: ElementPart,
         times: &mut PhaseTimes,
         with_jacobian: bool,
-        projections: Option<&[Vec<Option<Projection>>]>,
+        projected_at_x: Option<&Evaluation>,
     ) -> Result<Evaluation> {
         let model = self.model;
         let n = self.dofs.n_dofs;
@@ -627,8 +622,8 @@ impl IncrementContext<'_> {
                             hint: committed.hint.unwrap_or_default(),
                         }
                     }),
-                    None => match projections {
-                        Some(known) => known[c][k],
+                    None => match projected_at_x {
+                        Some(known) => known.nodal[c][k].1,
                         None => contact.tool.project(pose, &xn, committed.hint.as_ref()),
                     },
                 };

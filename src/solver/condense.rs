@@ -365,9 +365,14 @@ impl Condenser {
         plan.segment_start.push(plan.slots.len());
         condenser.slots = plan.slots;
         condenser.segment_start = plan.segment_start;
+        // The walk's kept-row segments, in its order (then one segment per node).
         condenser.kept_rows = (0..full.n)
             .filter(|&r| condenser.reduced_index[r].is_some() && !condenser.condensed_row[r])
             .collect();
+        debug_assert_eq!(
+            condenser.segment_start.len(),
+            condenser.kept_rows.len() + condenser.nodes.len() + 1
+        );
         Some(condenser)
     }
 

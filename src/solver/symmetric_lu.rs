@@ -89,6 +89,8 @@ pub struct SymbolicSymmetricLu {
     /// Floating-point operations of each supernode's numeric step (its descendant updates,
     /// its diagonal block and its triangular solves): what a partial refactorization saves.
     flops: Vec<f64>,
+    /// Their sum: a whole factorization's.
+    total_flops: f64,
     len: usize,
     /// Identifies this analysis, so that numeric factors kept for a partial
     /// refactorization are never reused on another one.
@@ -210,6 +212,7 @@ impl SymbolicSymmetricLu {
             slot: Vec::new(),
             entry_super: Vec::new(),
             flops: Vec::new(),
+            total_flops: 0.0,
             len,
             id: NEXT_ANALYSIS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         };
@@ -230,6 +233,7 @@ impl SymbolicSymmetricLu {
                     .sum::<f64>()
             })
             .collect();
+        analysis.total_flops = analysis.flops.iter().sum();
         let mut slot = Vec::with_capacity(pattern.nnz());
         let mut entry_super = Vec::with_capacity(pattern.nnz());
         for c in 0..n {
@@ -432,7 +436,7 @@ impl NumericSymmetricLu {
             }
         }
         self.position.resize(sy.n, 0);
-        self.flops_total += sy.flops.iter().sum::<f64>();
+        self.flops_total += sy.total_flops;
         for s in 0..ns {
             if !self.dirty[s] {
                 continue;
