@@ -146,6 +146,32 @@ pub trait Element<const D: usize>: std::fmt::Debug + Send + Sync {
         Ok(())
     }
 
+    /// Length of what one element remembers between the evaluations of a Newton attempt
+    /// ([`Self::evaluate_remembering`]); none by default.
+    fn memory_len(&self) -> usize {
+        0
+    }
+
+    /// [`Self::evaluate_into`] with the element's `memory` (length [`Self::memory_len`]; all
+    /// NaN at the start of an attempt), which it may read to start from and writes with a
+    /// `stiffness` only: line-search trials leave it as the last linearisation left it. The
+    /// result depends on it at round-off at most. The default ignores it.
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate_remembering(
+        &self,
+        ref_coords: &[Vec3],
+        u: &[Vec3],
+        committed: &[PointState],
+        trial: &mut [PointState],
+        material: &dyn Material,
+        memory: &mut [f64],
+        force: &mut [f64],
+        stiffness: Option<&mut [f64]>,
+    ) -> Result<()> {
+        let _ = memory;
+        self.evaluate_into(ref_coords, u, committed, trial, material, force, stiffness)
+    }
+
     /// Reference volume weight `w_g det J_g` of each integration point.
     fn point_volumes(&self, ref_coords: &[Vec3]) -> Result<Vec<f64>>;
 

@@ -52,22 +52,38 @@
 //! # Element-level condensation of the EAS parameters
 //!
 //! With `W = Σ_p w_p ψ(E_p(u, α))`, `r_u = Σ w Bᵀ S`, `r_α = Σ w Mᵀ S`: the parameters `α`
-//! solve `r_α(u, α) = 0` by a local Newton iteration started from the committed values
-//! (`PointState::enhanced`, so they are saved across increments and in checkpoints), with
-//! full steps and, where those fail (a 2-cycle across the elastic-plastic switch of some
-//! points, or an overshoot into material inversion), again with halved steps
-//! (`SolidShell::solve_enhanced_parameters`), and
+//! solve `r_α(u, α) = 0` by a local Newton iteration (`SolidShell::solve_enhanced_parameters`,
+//! "Local solve" below; the converged values are kept in `PointState::enhanced`, so across
+//! increments and in checkpoints), and
 //!
 //! ```text
 //! f = r_u(u, α(u)),    K = K_uu - K_uα K_αα⁻¹ K_αu,
 //! K_uu = Σ w (Bᵀ ℂ B + G(S)),  K_uα = Σ w Bᵀ ℂ M,  K_αu = Σ w Mᵀ ℂ B,  K_αα = Σ w Mᵀ ℂ M,
 //! ```
 //!
-//! the exact derivative of `f` (implicit function theorem). Solving `α` to convergence in
-//! every call keeps the element a function of `(u, committed)` only, like every other
-//! element: a Newton iterate, a line-search trial and a cut-back step never depend on the
-//! previous iterate. `G(S)` is the geometric stiffness `Σ_c S^c ∂²E_c/∂u²` of the
-//! (ANS-interpolated) covariant strains.
+//! the exact derivative of `f` (implicit function theorem). `G(S)` is the geometric
+//! stiffness `Σ_c S^c ∂²E_c/∂u²` of the (ANS-interpolated) covariant strains.
+//!
+//! # Local solve
+//!
+//! Solving `α` to convergence in every call keeps the element a function of
+//! `(u, committed)` only, like every other element: a Newton iterate, a line-search trial
+//! and a cut-back step never depend on the previous iterate. The iteration stops once its
+//! next step `δ = K_αα⁻¹ r_α` is at most [`LOCAL_TOLERANCE`] (10⁻⁸) of the element's strain
+//! scale, and takes that step to first order, `α - δ` and `S - ℂ M δ`: force, stresses and
+//! parameters are then within `O(δ²)` (10⁻¹⁶ relative) of the exact local solution; the
+//! tangent and the material's internal variables are those of the last iterate, `δ` away.
+//!
+//! Where it starts decides its cost (each iteration updates every point's material).
+//! Within a Newton attempt the assembly gives each element a memory
+//! ([`Element::evaluate_remembering`]): an evaluation with the stiffness writes its `α`,
+//! its displacements `u₀` and `P = K_αα⁻¹ K_αu` (already formed for `K`), and the next
+//! evaluation starts from the linearised `α - P (u - u₀)`, whose error is of second order
+//! in the step `u - u₀`; line-search trials read the memory and leave it. Where the iteration
+//! from the prediction fails or wanders ([`PREDICTED_LOCAL_ITERATIONS`]), it starts again
+//! from the remembered `α` (without a memory: the values `trial` carries, else the committed
+//! ones) with full steps and, where those fail too (a 2-cycle across the elastic-plastic
+//! switch of some points, or an overshoot into material inversion), with halved steps.
 //!
 //! # Integration and cost
 //!
@@ -118,8 +134,25 @@ type Modes = SVector<f64, ENHANCED_PARAMETERS>;
 /// Most local Newton iterations for the EAS parameters.
 pub(super) const MAX_LOCAL_ITERATIONS: usize = 30;
 
+/// Most local Newton iterations from a linearised prediction before the remembered start
+/// is tried instead: from a good prediction the iteration is quadratic and needs two or
+/// three; one that wanders (a prediction across the elastic-plastic switch, or from far
+/// away) would otherwise spend all [`MAX_LOCAL_ITERATIONS`].
+const PREDICTED_LOCAL_ITERATIONS: usize = 6;
+
 /// The smallest fraction of a local Newton step tried before the step is taken as it is.
 const MIN_LOCAL_STEP: f64 = 1.0 / 1024.0;
+
+/// The local iteration stops once its next step `δ` is at most this fraction of the
+/// element's strain scale; the force and stresses take that step to first order
+/// (`S - ℂ M δ`). Their distance to the exact local solution is then of order
+/// `(δ / scale)² ≤ 10⁻¹⁶` relative, round-off (module docs, "Local solve").
+const LOCAL_TOLERANCE: f64 = 1e-8;
+
+/// Length of a solid-shell's memory ([`Element::memory_len`]): a mark (1 once written),
+/// the enhanced parameters and nodal displacements of the last linearisation, and
+/// `P = K_αα⁻¹ K_αu` there (column-major).
+pub const MEMORY: usize = 1 + ENHANCED_PARAMETERS + DOFS + ENHANCED_PARAMETERS * DOFS;
 
 /// The solid-shell hexahedron; see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -162,34 +195,6 @@ impl ElementKind {
                 "must be \"hexahedron\" or \"solid_shell\"",
             )),
         }
-    }
-}
-
-/// The enhanced parameters of an increment's last evaluation, to start the next
-/// evaluation's local iterations from (the solid-shell reads them from the trial states it
-/// is given, [`SolidShell`]'s `evaluate_into`): near the converged values, where the
-/// committed ones are an increment away. The converged parameters are the same either way,
-/// to the local tolerance. One per Newton attempt (a cut-back starts afresh).
-#[derive(Debug, Default)]
-pub struct WarmStart(std::sync::Mutex<Vec<[f64; ENHANCED_PARAMETERS]>>);
-
-impl WarmStart {
-    /// Puts the kept parameters into `trial` (a copy of the committed states), when there
-    /// are as many.
-    pub fn seed(&self, trial: &mut [PointState]) {
-        let kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        if kept.len() == trial.len() {
-            for (state, alpha) in trial.iter_mut().zip(kept.iter()) {
-                state.enhanced = *alpha;
-            }
-        }
-    }
-
-    /// Keeps the parameters of an evaluation's trial states.
-    pub fn keep(&self, trial: &[PointState]) {
-        let mut kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        kept.clear();
-        kept.extend(trial.iter().map(|s| s.enhanced));
     }
 }
 
@@ -707,8 +712,9 @@ impl SolidShell {
     }
 
     /// Solves `r_α(u, α) = 0` for the enhanced parameters by Newton's method from `alpha`
-    /// (module docs), leaving the converged parameters in `alpha`, each point's stress and
-    /// tangent in `stresses` and `tangents` and its material state in `trial`. With `damped`,
+    /// (module docs) until the next step `δ` is below [`LOCAL_TOLERANCE`], leaving the
+    /// last iterate in `alpha`, its stresses and tangents in `stresses` and `tangents`,
+    /// its material states in `trial`, and returning `δ` (not taken). With `damped`,
     /// a step that raises `|r_α|` (or leaves the material's domain) is halved and retried,
     /// down to [`MIN_LOCAL_STEP`] of it: `-K_αα⁻¹ r_α` is a descent direction of `|r_α|²`,
     /// so some fraction of it always lowers the residual. Full steps are tried first
@@ -724,12 +730,12 @@ impl SolidShell {
         material: &dyn Material,
         strain_scale: f64,
         damped: bool,
+        max_steps: usize,
         alpha: &mut Modes,
         stresses: &mut [Voigt],
         tangents: &mut [Tangent],
-    ) -> Result<()> {
+    ) -> Result<Modes> {
         let ne = self.modes();
-        let mut previous_step = f64::INFINITY;
         // The last Newton step taken: the parameters it started from, the step, the
         // residual norm there and the fraction of the step taken.
         let mut last: Option<(Modes, Modes, f64, f64)> = None;
@@ -772,27 +778,23 @@ impl SolidShell {
             let step = solve_enhanced(k_aa, ne, &r_a)?;
             let size = step.amax();
             let scale = strain_scale.max(alpha.amax());
-            // Converged, or stalled at round-off (the step no longer shrinks).
-            if size <= 1e-14 * scale
-                || (newton_steps >= 2 && size <= 1e-9 * scale && size > 0.25 * previous_step)
-            {
-                return Ok(());
+            if size <= LOCAL_TOLERANCE * scale {
+                return Ok(step);
             }
-            if newton_steps >= MAX_LOCAL_ITERATIONS || !size.is_finite() {
+            if newton_steps >= max_steps || !size.is_finite() {
                 return Err(Error::NoConvergence(format!(
                     "enhanced-strain parameters not converged after {newton_steps} local \
                      iterations (last step {size:e})"
                 )));
             }
-            previous_step = size;
             last = Some((*alpha, step, norm, 1.0));
             newton_steps += 1;
             *alpha -= step;
         }
     }
 
-    /// The output part of a converged point's `trial`: Cauchy stress (finite strain:
-    /// [`cauchy_stress`]), `F` and the enhanced parameters.
+    /// The output part of a converged point's `trial`: the stress `s` (finite strain: its
+    /// Cauchy stress, [`cauchy_stress`]), `F` and the enhanced parameters.
     fn finish_point(
         &self,
         point: &Point,
@@ -803,6 +805,8 @@ impl SolidShell {
         if self.finite {
             let e = point.strain + point.modes * alpha;
             trial.stress = cauchy_stress(&point.f, &e, s)?;
+        } else {
+            trial.stress = *s;
         }
         trial.deformation_gradient = point.f;
         trial.enhanced = (*alpha).into();
@@ -892,10 +896,10 @@ impl Element<DOFS> for SolidShell {
         response_through_into(self, ref_coords, u, committed, trial, material)
     }
 
-    /// The enhanced parameters start from those `trial` carries when they are finite (the
-    /// last iterate's, if the caller seeded them: [`WarmStart`]; else the committed ones,
-    /// which an unseeded `trial`, a copy of `committed`, carries), and are solved to
-    /// round-off: the result is the same function of `(u, committed)` whatever the start.
+    /// The enhanced parameters start from those `trial` carries when they are finite (else
+    /// the committed ones, which an unseeded `trial`, a copy of `committed`, carries), and
+    /// are solved to [`LOCAL_TOLERANCE`]: the result is the same function of
+    /// `(u, committed)` whatever the start, to round-off.
     fn evaluate_into(
         &self,
         ref_coords: &[Vec3],
@@ -906,29 +910,74 @@ impl Element<DOFS> for SolidShell {
         force: &mut [f64],
         stiffness: Option<&mut [f64]>,
     ) -> Result<()> {
+        let mut memory = [f64::NAN; MEMORY];
+        self.evaluate_remembering(
+            ref_coords,
+            u,
+            committed,
+            trial,
+            material,
+            &mut memory,
+            force,
+            stiffness,
+        )
+    }
+
+    fn memory_len(&self) -> usize {
+        MEMORY
+    }
+
+    /// Remembers, with the stiffness, the enhanced parameters, the displacements and
+    /// `P = K_αα⁻¹ K_αu`; the next call starts its local iteration from the linearised
+    /// `α - P (u' - u)` (module docs, "Local solve"), and from the remembered `α` where
+    /// that fails.
+    fn evaluate_remembering(
+        &self,
+        ref_coords: &[Vec3],
+        u: &[Vec3],
+        committed: &[PointState],
+        trial: &mut [PointState],
+        material: &dyn Material,
+        memory: &mut [f64],
+        force: &mut [f64],
+        stiffness: Option<&mut [f64]>,
+    ) -> Result<()> {
         super::hex8::check_len("force", force.len(), DOFS)?;
         if let Some(k) = &stiffness {
             super::hex8::check_len("stiffness", k.len(), DOFS * DOFS)?;
         }
+        super::hex8::check_len("memory", memory.len(), MEMORY)?;
         self.check(committed, trial)?;
         let x = nodes_array("ref_coords", ref_coords)?;
         let u = nodes_array("u", u)?;
         let (points, levels) = self.points(&x, &u)?;
         let ne = self.modes();
-        let start = if trial[0].enhanced.iter().all(|a| a.is_finite()) {
-            trial[0].enhanced
+        let u_flat = SVector::<f64, DOFS>::from_fn(|i, _| u[i / 3][i % 3]);
+        let remembered = memory[0] == 1.0;
+        let mut unpredicted = Modes::zeros();
+        if remembered {
+            unpredicted.copy_from_slice(&memory[1..1 + ENHANCED_PARAMETERS]);
         } else {
-            committed[0].enhanced
-        };
-        let mut alpha = Modes::zeros();
-        alpha.as_mut_slice()[..ne].copy_from_slice(&start[..ne]);
+            let start = if trial[0].enhanced.iter().all(|a| a.is_finite()) {
+                trial[0].enhanced
+            } else {
+                committed[0].enhanced
+            };
+            unpredicted.as_mut_slice()[..ne].copy_from_slice(&start[..ne]);
+        }
+        let predicted = remembered.then(|| {
+            let at = 1 + ENHANCED_PARAMETERS;
+            let u_then = SVector::<f64, DOFS>::from_column_slice(&memory[at..at + DOFS]);
+            let p = SMatrix::<f64, ENHANCED_PARAMETERS, DOFS>::from_column_slice(
+                &memory[at + DOFS..MEMORY],
+            );
+            unpredicted - p * (u_flat - u_then)
+        });
         let strain_scale = points.iter().map(|p| p.strain.amax()).fold(0.0, f64::max);
         let np = points.len();
         let mut stresses = [Voigt::zeros(); 4 * MAX_THICKNESS_POINTS];
         let mut tangents = [Tangent::zeros(); 4 * MAX_THICKNESS_POINTS];
-        // Full steps first; halved ones only where those fail (doc of the method).
-        let from = alpha;
-        let mut local = |damped: bool, alpha: &mut Modes| {
+        let mut local = |damped: bool, max_steps: usize, alpha: &mut Modes| {
             self.solve_enhanced_parameters(
                 &points,
                 committed,
@@ -936,15 +985,37 @@ impl Element<DOFS> for SolidShell {
                 material,
                 strain_scale,
                 damped,
+                max_steps,
                 alpha,
                 &mut stresses,
                 &mut tangents,
             )
         };
-        if let Err(full_steps) = local(false, &mut alpha) {
-            alpha = from;
-            local(true, &mut alpha).map_err(|_| full_steps)?;
+        // Full steps from the prediction, then from the remembered (or given) start, then
+        // halved ones from there (doc of `solve_enhanced_parameters`).
+        let mut alpha = predicted.unwrap_or(unpredicted);
+        let from_prediction = match predicted {
+            Some(_) => local(false, PREDICTED_LOCAL_ITERATIONS, &mut alpha).ok(),
+            None => None,
+        };
+        let delta = match from_prediction {
+            Some(delta) => delta,
+            None => {
+                alpha = unpredicted;
+                match local(false, MAX_LOCAL_ITERATIONS, &mut alpha) {
+                    Ok(delta) => delta,
+                    Err(full_steps) => {
+                        alpha = unpredicted;
+                        local(true, MAX_LOCAL_ITERATIONS, &mut alpha).map_err(|_| full_steps)?
+                    }
+                }
+            }
+        };
+        // The last step to first order: `α - δ`, `S - ℂ M δ` (LOCAL_TOLERANCE).
+        for ((point, s), c) in points.iter().zip(&mut stresses).zip(&tangents) {
+            *s -= c * (point.modes * delta);
         }
+        alpha -= delta;
         let force: &mut [f64; DOFS] = force.try_into().expect("length checked");
         let mut f = SVector::<f64, DOFS>::zeros();
         for ((point, s), state) in points.iter().zip(&stresses).zip(trial.iter_mut()) {
@@ -973,6 +1044,11 @@ impl Element<DOFS> for SolidShell {
         let correction = solve_enhanced(k_aa, ne, &k_au)?;
         k.gemm(-1.0, &k_ua, &correction, 1.0);
         k_out.copy_from_slice(k.as_slice());
+        memory[0] = 1.0;
+        let at = 1 + ENHANCED_PARAMETERS;
+        memory[1..at].copy_from_slice(alpha.as_slice());
+        memory[at..at + DOFS].copy_from_slice(u_flat.as_slice());
+        memory[at + DOFS..].copy_from_slice(correction.as_slice());
         Ok(())
     }
 

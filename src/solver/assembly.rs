@@ -140,6 +140,12 @@ struct ElementBuffers {
     stiffness: Vec<f64>,
 }
 
+/// What the elements remember between the evaluations of one Newton attempt
+/// ([`crate::element::Element::evaluate_remembering`]): `memory_len` numbers per element,
+/// NaN until an element writes them. A new attempt (a cut-back too) starts with none.
+#[derive(Debug, Default)]
+pub struct ElementMemory(std::sync::Mutex<Vec<f64>>);
+
 /// Evaluates every element at the unknowns `x`, on `threads` threads over contiguous
 /// blocks of elements, writing the trial states of their integration points and each
 /// element's force (and, with `tangent`, stiffness) straight into its place in the
@@ -152,10 +158,18 @@ fn evaluate_elements(
     trial: &mut [PointState],
     threads: usize,
     tangent: bool,
+    memory: &ElementMemory,
 ) -> Result<ElementBuffers> {
     const D: usize = crate::element::hex8::DOFS;
     let element = model.element()?;
     let per_elem = element.point_count();
+    let remembers = element.memory_len();
+    let mut memory = memory.0.lock().unwrap_or_else(|e| e.into_inner());
+    let memory_len = model.mesh.hexes.len() * remembers;
+    if memory.len() != memory_len {
+        memory.clear();
+        memory.resize(memory_len, f64::NAN);
+    }
     let (hexes, nodes, material) = (
         &model.mesh.hexes,
         &model.mesh.nodes,
@@ -166,46 +180,57 @@ fn evaluate_elements(
         force: vec![0.0; n_elem * D],
         stiffness: vec![0.0; if tangent { n_elem * D * D } else { 0 }],
     };
-    let evaluate_block =
-        |first: usize, trial: &mut [PointState], force: &mut [f64], stiffness: &mut [f64]| {
-            let mut xs = [Vec3::zeros(); 8];
-            let mut us = [Vec3::zeros(); 8];
-            let mut stiffness = tangent.then(|| stiffness.chunks_mut(D * D));
-            for (k, (trial_e, force_e)) in trial
-                .chunks_mut(per_elem)
-                .zip(force.chunks_mut(D))
-                .enumerate()
-            {
-                let e = first + k;
-                for (a, &node) in hexes[e].iter().enumerate() {
-                    xs[a] = nodes[node];
-                    us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
-                }
-                let committed_e = &committed[e * per_elem..(e + 1) * per_elem];
-                let stiffness_e = stiffness.as_mut().and_then(|s| s.next());
-                element
-                    .evaluate_into(
-                        &xs,
-                        &us,
-                        committed_e,
-                        trial_e,
-                        material,
-                        force_e,
-                        stiffness_e,
-                    )
-                    // Any element failure inside an iterate is retryable (a smaller step
-                    // may pass), kept as "no convergence" without a second kind prefix.
-                    .map_err(|err| match in_element(err, e) {
-                        err @ Error::NoConvergence(_) => err,
-                        other => Error::NoConvergence(other.to_string()),
-                    })?;
+    let evaluate_block = |first: usize,
+                          trial: &mut [PointState],
+                          force: &mut [f64],
+                          stiffness: &mut [f64],
+                          memory: &mut [f64]| {
+        let mut xs = [Vec3::zeros(); 8];
+        let mut us = [Vec3::zeros(); 8];
+        let mut stiffness = tangent.then(|| stiffness.chunks_mut(D * D));
+        for (k, (trial_e, force_e)) in trial
+            .chunks_mut(per_elem)
+            .zip(force.chunks_mut(D))
+            .enumerate()
+        {
+            let e = first + k;
+            for (a, &node) in hexes[e].iter().enumerate() {
+                xs[a] = nodes[node];
+                us[a] = Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
             }
-            Ok::<_, Error>(())
-        };
+            let committed_e = &committed[e * per_elem..(e + 1) * per_elem];
+            let stiffness_e = stiffness.as_mut().and_then(|s| s.next());
+            let memory_e = &mut memory[k * remembers..(k + 1) * remembers];
+            element
+                .evaluate_remembering(
+                    &xs,
+                    &us,
+                    committed_e,
+                    trial_e,
+                    material,
+                    memory_e,
+                    force_e,
+                    stiffness_e,
+                )
+                // Any element failure inside an iterate is retryable (a smaller step
+                // may pass), kept as "no convergence" without a second kind prefix.
+                .map_err(|err| match in_element(err, e) {
+                    err @ Error::NoConvergence(_) => err,
+                    other => Error::NoConvergence(other.to_string()),
+                })?;
+        }
+        Ok::<_, Error>(())
+    };
     // Below a few dozen elements, starting threads costs more than it saves.
     const MIN_PARALLEL_ELEMENTS: usize = 64;
     if threads <= 1 || n_elem < MIN_PARALLEL_ELEMENTS {
-        evaluate_block(0, trial, &mut buffers.force, &mut buffers.stiffness)?;
+        evaluate_block(
+            0,
+            trial,
+            &mut buffers.force,
+            &mut buffers.stiffness,
+            &mut memory,
+        )?;
         return Ok(buffers);
     }
     let block = n_elem.div_ceil(threads);
@@ -213,15 +238,22 @@ fn evaluate_elements(
     let mut stiffness_chunks: Vec<&mut [f64]> =
         buffers.stiffness.chunks_mut(stiffness_block).collect();
     stiffness_chunks.resize_with(n_elem.div_ceil(block), Default::default);
+    let mut memory_chunks: Vec<&mut [f64]> = if remembers == 0 {
+        Vec::new()
+    } else {
+        memory.chunks_mut(block * remembers).collect()
+    };
+    memory_chunks.resize_with(n_elem.div_ceil(block), Default::default);
     let results: Vec<Result<()>> = std::thread::scope(|scope| {
         let handles: Vec<_> = trial
             .chunks_mut(block * per_elem)
             .zip(buffers.force.chunks_mut(block * D))
             .zip(stiffness_chunks)
+            .zip(memory_chunks)
             .enumerate()
-            .map(|(i, ((trial, force), stiffness))| {
+            .map(|(i, (((trial, force), stiffness), memory))| {
                 let evaluate_block = &evaluate_block;
-                scope.spawn(move || evaluate_block(i * block, trial, force, stiffness))
+                scope.spawn(move || evaluate_block(i * block, trial, force, stiffness, memory))
             })
             .collect();
         handles
@@ -312,8 +344,9 @@ pub struct IncrementContext<'a> {
     pub is_fixed: &'a [bool],
     /// Contact status imposed per (tool, candidate) by the anti-cycling treatment.
     pub forced: Option<Vec<Vec<Option<crate::contact::ContactStatus>>>>,
-    /// The solid-shell's enhanced parameters of the last evaluation, its next start.
-    pub warm_start: crate::element::solid_shell::WarmStart,
+    /// What the elements remember between evaluations (the solid-shell: its last
+    /// linearisation, the start of its next local solve).
+    pub element_memory: ElementMemory,
     /// Whether full evaluations keep their element stiffness (status prediction re-solves
     /// with other contact statuses at the same unknowns).
     pub keep_element_jacobian: bool,
@@ -366,7 +399,6 @@ impl IncrementContext<'_> {
         let threads = element_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);
         let mut trial_points = self.committed_points.to_vec();
-        self.warm_start.seed(&mut trial_points);
         let elements = evaluate_elements(
             model,
             x,
@@ -374,6 +406,7 @@ impl IncrementContext<'_> {
             &mut trial_points,
             threads,
             true,
+            &self.element_memory,
         )?;
         let mut jac = SparseMatrix::zeros(self.pattern.clone());
         slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
@@ -535,7 +568,6 @@ impl IncrementContext<'_> {
             }
         };
         let mut trial_points = self.committed_points.to_vec();
-        self.warm_start.seed(&mut trial_points);
         let t0 = Instant::now();
         let threads = element_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);
@@ -546,6 +578,7 @@ impl IncrementContext<'_> {
             &mut trial_points,
             threads,
             with_jacobian,
+            &self.element_memory,
         )?;
         for (hex, force) in model.mesh.hexes.iter().zip(elements.force.chunks(24)) {
             for (a, &na) in hex.iter().enumerate() {
@@ -714,7 +747,6 @@ impl IncrementContext<'_> {
         } else {
             jac.values = Vec::new();
         }
-        self.warm_start.keep(&trial_points);
         Ok(Evaluation {
             residual,
             jacobian: jac,
@@ -907,7 +939,7 @@ mod tests {
                 frozen: None,
                 is_fixed: &is_fixed,
                 forced: None,
-                warm_start: Default::default(),
+                element_memory: Default::default(),
                 keep_element_jacobian: true,
             };
             let mut times = PhaseTimes::default();

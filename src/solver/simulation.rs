@@ -312,7 +312,7 @@ impl Simulation {
             frozen,
             is_fixed: &self.is_fixed,
             forced: None,
-            warm_start: Default::default(),
+            element_memory: Default::default(),
             keep_element_jacobian: self.model.settings.status_prediction > 0,
         }
     }
