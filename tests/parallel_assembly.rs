@@ -1,12 +1,14 @@
 //! The element loop runs on several threads (setting `threads`); every element's response
 //! is scattered in element order, so the results must be bit-for-bit those of one thread,
 //! whatever the number of threads (including counts that leave blocks of unequal size).
-//! The strip has 84 elements, above the 64 below which the loop stays on one thread.
+//! The strip has 84 elements, above the 64 below which the loop stays on one thread. The
+//! solid-shell also keeps a memory per element between evaluations, split between the
+//! threads like the states.
 
 mod common;
 
 use std::sync::Arc;
-use tribo::element::StrainTheory;
+use tribo::element::{ElementKind, StrainTheory};
 use tribo::geometry::{Cylinder, Vec3};
 use tribo::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
 use tribo::mesh::Mesh;
@@ -15,8 +17,12 @@ use tribo::tool::ScalarSchedule;
 
 /// A plastic strip (finite strain, Hill48, Swift) pressed into a rough cylinder and dragged:
 /// plastic flow and slip, so the integration-point states written by each thread matter.
-fn strip(threads: usize, kinematics: StrainTheory) -> (Vec<f64>, Vec<usize>) {
-    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 1.0), [21, 1, 4]).unwrap();
+fn strip(threads: usize, kinematics: StrainTheory, element: ElementKind) -> (Vec<f64>, Vec<usize>) {
+    let cells = match element {
+        ElementKind::Hexahedron => [21, 1, 4],
+        ElementKind::SolidShell => [42, 2, 1],
+    };
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 1.0), cells).unwrap();
     let material = ElastoPlastic::new(
         LinearElastic::new(70e3, 0.33).unwrap(),
         Hill48::from_lankford(0.7, 1.3, 2.1).unwrap(),
@@ -41,6 +47,7 @@ fn strip(threads: usize, kinematics: StrainTheory) -> (Vec<f64>, Vec<usize>) {
             .unwrap();
     }
     model.settings.kinematics = kinematics;
+    model.settings.element = element;
     model.settings.end_time = 2.0;
     model.settings.increments = 8;
     model.settings.threads = threads;
@@ -51,18 +58,22 @@ fn strip(threads: usize, kinematics: StrainTheory) -> (Vec<f64>, Vec<usize>) {
 }
 
 /// Both hexahedra: F-bar with the log-strain return mapping, and the small-strain B-bar
-/// element's direct kernel.
+/// element's direct kernel; and the finite-strain solid-shell.
 #[test]
 fn results_do_not_depend_on_the_number_of_element_threads() {
-    for kinematics in [StrainTheory::Finite, StrainTheory::Small] {
-        let (one, its_one) = strip(1, kinematics);
+    for (kinematics, element) in [
+        (StrainTheory::Finite, ElementKind::Hexahedron),
+        (StrainTheory::Small, ElementKind::Hexahedron),
+        (StrainTheory::Finite, ElementKind::SolidShell),
+    ] {
+        let (one, its_one) = strip(1, kinematics, element);
         let plastic_or_moved = one.iter().any(|v| v.abs() > 1e-3);
         assert!(
             plastic_or_moved,
             "the strip must deform for the test to mean anything"
         );
         for threads in [2, 5] {
-            let (many, its_many) = strip(threads, kinematics);
+            let (many, its_many) = strip(threads, kinematics, element);
             assert_eq!(
                 its_one, its_many,
                 "{kinematics:?}, {threads} threads: Newton iterations differ"

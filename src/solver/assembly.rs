@@ -221,18 +221,56 @@ fn evaluate_elements(
         }
         Ok::<_, Error>(())
     };
+    // A failed evaluation leaves the memory as it was: else which elements had written
+    // theirs before the failure would depend on the thread count.
+    let before = (tangent && remembers > 0).then(|| memory.clone());
     // Below a few dozen elements, starting threads costs more than it saves.
     const MIN_PARALLEL_ELEMENTS: usize = 64;
-    if threads <= 1 || n_elem < MIN_PARALLEL_ELEMENTS {
+    let outcome = if threads <= 1 || n_elem < MIN_PARALLEL_ELEMENTS {
         evaluate_block(
             0,
             trial,
             &mut buffers.force,
             &mut buffers.stiffness,
             &mut memory,
-        )?;
-        return Ok(buffers);
+        )
+    } else {
+        evaluate_on_threads(
+            n_elem,
+            threads,
+            per_elem,
+            remembers,
+            tangent,
+            trial,
+            &mut buffers,
+            &mut memory,
+            &evaluate_block,
+        )
+    };
+    if let (Err(_), Some(before)) = (&outcome, before) {
+        *memory = before;
     }
+    outcome.map(|()| buffers)
+}
+
+/// The element loop of [`evaluate_elements`] on `threads` threads, over contiguous blocks
+/// of elements; the first error in element order.
+#[allow(clippy::too_many_arguments)]
+fn evaluate_on_threads<F>(
+    n_elem: usize,
+    threads: usize,
+    per_elem: usize,
+    remembers: usize,
+    tangent: bool,
+    trial: &mut [PointState],
+    buffers: &mut ElementBuffers,
+    memory: &mut [f64],
+    evaluate_block: &F,
+) -> Result<()>
+where
+    F: Fn(usize, &mut [PointState], &mut [f64], &mut [f64], &mut [f64]) -> Result<()> + Sync,
+{
+    const D: usize = crate::element::hex8::DOFS;
     let block = n_elem.div_ceil(threads);
     let stiffness_block = if tangent { block * D * D } else { 1 };
     let mut stiffness_chunks: Vec<&mut [f64]> =
@@ -252,7 +290,6 @@ fn evaluate_elements(
             .zip(memory_chunks)
             .enumerate()
             .map(|(i, (((trial, force), stiffness), memory))| {
-                let evaluate_block = &evaluate_block;
                 scope.spawn(move || evaluate_block(i * block, trial, force, stiffness, memory))
             })
             .collect();
@@ -261,10 +298,7 @@ fn evaluate_elements(
             .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
     });
-    for r in results {
-        r?;
-    }
-    Ok(buffers)
+    results.into_iter().collect()
 }
 
 /// Wall time spent in each phase of assembly (seconds), and the evaluations made,
