@@ -291,32 +291,17 @@ impl Simulation {
         if settings.extrapolate {
             self.extrapolate(t_new, &mut x);
         }
-        // Named in the error: a first iterate that cannot be evaluated fails the attempt
-        // before Newton starts. An extrapolated one (an element inverted by continuing the
-        // last increment's motion, say) is first replaced by the unextrapolated start, as
-        // one far worse than it is below.
-        let mut unextrapolated = unextrapolated;
-        let mut eval = match self
+        // Named in the error: a first iterate that cannot be evaluated (an element inverted
+        // by the extrapolated guess, say) fails the attempt before Newton starts.
+        let first = if unextrapolated.is_some() {
+            "at the first iterate (extrapolated from the last increment)"
+        } else {
+            "at the first iterate"
+        };
+        let mut eval = self
             .start_iterate(&ctx, t_new, &mut x, linear, times)
             .and_then(|()| ctx.evaluate(&x, times))
-        {
-            Ok(eval) => eval,
-            Err(err) => {
-                let Some(plain) = unextrapolated.take() else {
-                    return Err(crate::element::prefix(err, "at the first iterate"));
-                };
-                x = plain;
-                self.start_iterate(&ctx, t_new, &mut x, linear, times)
-                    .and_then(|()| ctx.evaluate(&x, times))
-                    .map_err(|err| {
-                        crate::element::prefix(
-                            err,
-                            "at the first iterate (unextrapolated, the extrapolated one \
-                             having failed too)",
-                        )
-                    })?
-            }
-        };
+            .map_err(|err| crate::element::prefix(err, first))?;
         // The extrapolated start is a guess that the increment continues the last one's
         // motion. Where it does not (a rotating thin beam: continued linearly, a rotation
         // stretches the fibres, whose membrane stiffness is (L/t)^2 times the bending one),
