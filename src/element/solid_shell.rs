@@ -152,7 +152,12 @@ const LOCAL_TOLERANCE: f64 = 1e-8;
 /// Length of a solid-shell's memory ([`Element::memory_len`]): a mark (1 once written),
 /// the enhanced parameters and nodal displacements of the last linearisation, and
 /// `P = K_αα⁻¹ K_αu` there (column-major).
-pub const MEMORY: usize = 1 + ENHANCED_PARAMETERS + DOFS + ENHANCED_PARAMETERS * DOFS;
+pub const MEMORY: usize = MEMORY_P.end;
+
+/// Where each part of the memory ([`MEMORY`]) lies, after the mark at 0.
+const MEMORY_ALPHA: std::ops::Range<usize> = 1..1 + ENHANCED_PARAMETERS;
+const MEMORY_U: std::ops::Range<usize> = MEMORY_ALPHA.end..MEMORY_ALPHA.end + DOFS;
+const MEMORY_P: std::ops::Range<usize> = MEMORY_U.end..MEMORY_U.end + ENHANCED_PARAMETERS * DOFS;
 
 /// The solid-shell hexahedron; see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -956,7 +961,7 @@ impl Element<DOFS> for SolidShell {
         let remembered = memory[0] == 1.0;
         let mut unpredicted = Modes::zeros();
         if remembered {
-            unpredicted.copy_from_slice(&memory[1..1 + ENHANCED_PARAMETERS]);
+            unpredicted.copy_from_slice(&memory[MEMORY_ALPHA]);
         } else {
             let start = if trial[0].enhanced.iter().all(|a| a.is_finite()) {
                 trial[0].enhanced
@@ -966,11 +971,8 @@ impl Element<DOFS> for SolidShell {
             unpredicted.as_mut_slice()[..ne].copy_from_slice(&start[..ne]);
         }
         let predicted = remembered.then(|| {
-            let at = 1 + ENHANCED_PARAMETERS;
-            let u_then = SVector::<f64, DOFS>::from_column_slice(&memory[at..at + DOFS]);
-            let p = SMatrix::<f64, ENHANCED_PARAMETERS, DOFS>::from_column_slice(
-                &memory[at + DOFS..MEMORY],
-            );
+            let u_then = SVector::<f64, DOFS>::from_column_slice(&memory[MEMORY_U]);
+            let p = SMatrix::<f64, ENHANCED_PARAMETERS, DOFS>::from_column_slice(&memory[MEMORY_P]);
             unpredicted - p * (u_flat - u_then)
         });
         let strain_scale = points.iter().map(|p| p.strain.amax()).fold(0.0, f64::max);
@@ -994,10 +996,8 @@ impl Element<DOFS> for SolidShell {
         // Full steps from the prediction, then from the remembered (or given) start, then
         // halved ones from there (doc of `solve_enhanced_parameters`).
         let mut alpha = predicted.unwrap_or(unpredicted);
-        let from_prediction = match predicted {
-            Some(_) => local(false, PREDICTED_LOCAL_ITERATIONS, &mut alpha).ok(),
-            None => None,
-        };
+        let from_prediction =
+            predicted.and_then(|_| local(false, PREDICTED_LOCAL_ITERATIONS, &mut alpha).ok());
         let delta = match from_prediction {
             Some(delta) => delta,
             None => {
@@ -1045,10 +1045,9 @@ impl Element<DOFS> for SolidShell {
         k.gemm(-1.0, &k_ua, &correction, 1.0);
         k_out.copy_from_slice(k.as_slice());
         memory[0] = 1.0;
-        let at = 1 + ENHANCED_PARAMETERS;
-        memory[1..at].copy_from_slice(alpha.as_slice());
-        memory[at..at + DOFS].copy_from_slice(u_flat.as_slice());
-        memory[at + DOFS..].copy_from_slice(correction.as_slice());
+        memory[MEMORY_ALPHA].copy_from_slice(alpha.as_slice());
+        memory[MEMORY_U].copy_from_slice(u_flat.as_slice());
+        memory[MEMORY_P].copy_from_slice(correction.as_slice());
         Ok(())
     }
 
