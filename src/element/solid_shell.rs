@@ -149,6 +149,12 @@ const MIN_LOCAL_STEP: f64 = 1.0 / 1024.0;
 /// `(δ / scale)² ≤ 10⁻¹⁶` relative, round-off (module docs, "Local solve").
 const LOCAL_TOLERANCE: f64 = 1e-8;
 
+/// The least strain scale of [`LOCAL_TOLERANCE`]: the round-off of a unit stretch. At an
+/// unstrained element (scale 0) started a round-off away from its parameters' solution 0
+/// (a prediction from a strained memory), the quadratically shrinking steps would
+/// otherwise never pass (they stall at denormals: "last step 1e-323").
+const STRAIN_ROUND_OFF: f64 = f64::EPSILON;
+
 /// Length of a solid-shell's memory ([`Element::memory_len`]): a mark (1 once written),
 /// the enhanced parameters and nodal displacements of the last linearisation, and
 /// `P = K_αα⁻¹ K_αu` there (column-major).
@@ -782,7 +788,7 @@ impl SolidShell {
             }
             let step = solve_enhanced(k_aa, ne, &r_a)?;
             let size = step.amax();
-            let scale = strain_scale.max(alpha.amax());
+            let scale = strain_scale.max(alpha.amax()).max(STRAIN_ROUND_OFF);
             if size <= LOCAL_TOLERANCE * scale {
                 return Ok(step);
             }
