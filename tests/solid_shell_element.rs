@@ -73,9 +73,14 @@ fn evaluate(
     )
 }
 
+/// Largest absolute entry of `a`.
+fn largest(a: &[f64]) -> f64 {
+    a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
 /// Largest entry of `a - b` relative to the largest entry of `b`.
 fn relative(a: &[f64], b: &[f64]) -> f64 {
-    let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let scale = largest(b);
     a.iter()
         .zip(b)
         .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
@@ -693,7 +698,7 @@ fn an_unstrained_element_is_evaluated_from_a_strained_memory() {
                 Some(&mut k),
             )
             .unwrap();
-            let strained_force = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let strained_force = largest(&f);
             let mut trial = virgin.clone();
             el.evaluate_remembering(
                 &x,
@@ -706,7 +711,7 @@ fn an_unstrained_element_is_evaluated_from_a_strained_memory() {
                 None,
             )
             .unwrap_or_else(|e| panic!("seed {seed}, finite {finite}: {e}"));
-            let force = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let force = largest(&f);
             assert!(
                 force <= 1e-12 * strained_force,
                 "seed {seed}, finite {finite}: force {force:e} against {strained_force:e}"
