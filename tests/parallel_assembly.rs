@@ -1,6 +1,7 @@
 //! The element loop runs on several threads (setting `threads`); every element's response
 //! is scattered in element order, so the results must be bit-for-bit those of one thread,
 //! whatever the number of threads (including counts that leave blocks of unequal size).
+//! The factorization uses the same threads on disjoint subtrees, with the same effect.
 //! The strip has 84 elements, above the 64 below which the loop stays on one thread. The
 //! solid-shell also keeps a memory per element between evaluations, split between the
 //! threads like the states.
@@ -22,7 +23,20 @@ fn strip(threads: usize, kinematics: StrainTheory, element: ElementKind) -> (Vec
         ElementKind::Hexahedron => [21, 1, 4],
         ElementKind::SolidShell => [42, 2, 1],
     };
-    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 1.0, 1.0), cells).unwrap();
+    let (x, its, _) = strip_of([10.0, 1.0, 1.0], cells, threads, kinematics, element);
+    (x, its)
+}
+
+/// The strip of `size` on `cells`: its unknowns, Newton iterations per increment and how
+/// many factorizations ran on several threads.
+fn strip_of(
+    size: [f64; 3],
+    cells: [usize; 3],
+    threads: usize,
+    kinematics: StrainTheory,
+    element: ElementKind,
+) -> (Vec<f64>, Vec<usize>, usize) {
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::from(size), cells).unwrap();
     let material = ElastoPlastic::new(
         LinearElastic::new(70e3, 0.33).unwrap(),
         Hill48::from_lankford(0.7, 1.3, 2.1).unwrap(),
@@ -54,7 +68,11 @@ fn strip(threads: usize, kinematics: StrainTheory, element: ElementKind) -> (Vec
     let mut sim = Simulation::new(model).unwrap();
     sim.run(|_, _| Ok(())).unwrap();
     let iterations = sim.history.iter().map(|r| r.iterations).collect();
-    (sim.unknowns().to_vec(), iterations)
+    (
+        sim.unknowns().to_vec(),
+        iterations,
+        sim.split_factorizations(),
+    )
 }
 
 /// Both hexahedra: F-bar with the log-strain return mapping, and the small-strain B-bar
@@ -89,5 +107,44 @@ fn results_do_not_depend_on_the_number_of_element_threads() {
                 "{kinematics:?}, {threads} threads: unknowns differ by {worst:e}"
             );
         }
+    }
+}
+
+/// The factorization runs on the same threads (disjoint subtrees of its elimination tree at
+/// once, `solver::symmetric_lu`, "Threads") once a factorization is large enough: a sheet
+/// of 24 x 24 x 1 hexahedra (3,750 displacement unknowns; a plate's elimination tree
+/// branches, a strip's is nearly a chain) under the roller gives the one-thread results
+/// bit for bit on 2 and 3 threads, and its factorizations did run split.
+#[test]
+fn results_do_not_depend_on_the_number_of_factorization_threads() {
+    let (size, cells) = ([10.0, 10.0, 1.0], [24, 24, 1]);
+    let (one, its_one, split_one) = strip_of(
+        size,
+        cells,
+        1,
+        StrainTheory::Finite,
+        ElementKind::Hexahedron,
+    );
+    assert_eq!(split_one, 0);
+    assert!(one.iter().any(|v| v.abs() > 1e-3));
+    for threads in [2, 3] {
+        let (many, its_many, split) = strip_of(
+            size,
+            cells,
+            threads,
+            StrainTheory::Finite,
+            ElementKind::Hexahedron,
+        );
+        println!("{threads} threads: {split} factorizations split");
+        assert!(split > 0, "{threads} threads: no factorization ran split");
+        assert_eq!(
+            its_one, its_many,
+            "{threads} threads: Newton iterations differ"
+        );
+        let identical = one
+            .iter()
+            .zip(&many)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(identical, "{threads} threads: unknowns differ");
     }
 }

@@ -124,8 +124,8 @@ impl DofMap {
     }
 }
 
-/// Number of element threads for the setting `threads` (0: every core).
-fn element_threads(setting: usize) -> usize {
+/// Threads for the elements and the factorization of the setting `threads` (0: every core).
+pub(super) fn worker_threads(setting: usize) -> usize {
     match setting {
         0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
         n => n,
@@ -430,7 +430,7 @@ impl IncrementContext<'_> {
         times.jacobian_completions += 1;
         let model = self.model;
         let t0 = Instant::now();
-        let threads = element_threads(model.settings.threads);
+        let threads = worker_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);
         let mut trial_points = self.committed_points.to_vec();
         let elements = evaluate_elements(
@@ -603,7 +603,7 @@ impl IncrementContext<'_> {
         };
         let mut trial_points = self.committed_points.to_vec();
         let t0 = Instant::now();
-        let threads = element_threads(model.settings.threads);
+        let threads = worker_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);
         let elements = evaluate_elements(
             model,

@@ -45,6 +45,15 @@ pub trait LinearSolver {
     /// pivoting one (on by default). Off, such a call fails instead: for a system that is
     /// only tried, such as a status prediction's re-solve.
     fn set_pivoting_fallback(&mut self, _allowed: bool) {}
+
+    /// Threads the factorization may use (1 by default). The solution does not depend on
+    /// it where the solver honours it ([`SymmetricLu`]: bit for bit the same factors).
+    fn set_threads(&mut self, _threads: usize) {}
+
+    /// Factorizations that ran on several threads ([`Self::set_threads`]).
+    fn split_factorizations(&self) -> usize {
+        0
+    }
 }
 
 /// A factorization that solves several right-hand sides at once: what the bordered solve
@@ -250,6 +259,8 @@ pub struct SymmetricLu {
     /// Refused systems fail instead of going to the pivoting LU
     /// ([`LinearSolver::set_pivoting_fallback`]).
     no_fallback: bool,
+    /// Threads of the numeric factorization ([`LinearSolver::set_threads`]).
+    threads: usize,
 }
 
 /// See [`SymmetricLu::failures_in_a_row`].
@@ -278,6 +289,7 @@ impl SymmetricLu {
             self.symbolic_count += 1;
         }
         let symbolic = self.symbolic.as_ref().expect("set above");
+        self.numeric.set_threads(self.threads);
         if self.numeric.factorize(symbolic, &a.values).is_err() {
             return Ok(false);
         }
@@ -350,9 +362,10 @@ impl LinearSolver for SymmetricLu {
         if border.is_empty() {
             return self.factor_and_solve(a, b, 1);
         }
-        let no_fallback = self.no_fallback;
+        let (no_fallback, threads) = (self.no_fallback, self.threads);
         self.symbolic_count += solve_bordered_in(&mut self.border, a, b, border, |inner| {
-            inner.no_fallback = no_fallback
+            inner.no_fallback = no_fallback;
+            inner.threads = threads;
         })?;
         Ok(())
     }
@@ -363,6 +376,18 @@ impl LinearSolver for SymmetricLu {
 
     fn set_pivoting_fallback(&mut self, allowed: bool) {
         self.no_fallback = !allowed;
+    }
+
+    fn set_threads(&mut self, threads: usize) {
+        self.threads = threads;
+    }
+
+    fn split_factorizations(&self) -> usize {
+        self.numeric.split_calls
+            + self
+                .border
+                .as_ref()
+                .map_or(0, |b| b.inner.split_factorizations())
     }
 }
 
@@ -437,6 +462,19 @@ impl LinearSolver for Solver {
     fn set_pivoting_fallback(&mut self, allowed: bool) {
         if let Solver::SymmetricLu(s) = self {
             s.set_pivoting_fallback(allowed);
+        }
+    }
+
+    fn set_threads(&mut self, threads: usize) {
+        if let Solver::SymmetricLu(s) = self {
+            s.set_threads(threads);
+        }
+    }
+
+    fn split_factorizations(&self) -> usize {
+        match self {
+            Solver::SymmetricLu(s) => s.split_factorizations(),
+            Solver::Lu(_) => 0,
         }
     }
 }

@@ -19,6 +19,7 @@ pub mod slots;
 pub mod sparse;
 pub mod status_prediction;
 pub mod step_control;
+pub mod subtree_split;
 pub mod symmetric_lu;
 pub mod system_dump;
 

@@ -97,8 +97,10 @@ pub struct SolverSettings {
     /// status boundary linearised on the status they are heading into (0: off; see
     /// `status_prediction`).
     pub status_prediction: usize,
-    /// Threads evaluating elements (0: as many as the machine has cores). The results do
-    /// not depend on it: elements are scattered into the global system in element order.
+    /// Threads evaluating elements and factorizing (0: as many as the machine has cores).
+    /// The results do not depend on it: elements are scattered into the global system in
+    /// element order, and each supernode of the factorization is computed by the same
+    /// operations whatever thread runs it (`symmetric_lu`, "Threads").
     pub threads: usize,
 }
 

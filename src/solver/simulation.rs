@@ -332,6 +332,11 @@ impl Simulation {
         self.linear.symbolic_analyses()
     }
 
+    /// How many numeric factorizations ran on several threads (setting `threads`).
+    pub fn split_factorizations(&self) -> usize {
+        self.linear.split_factorizations()
+    }
+
     /// Committed unknowns [u, lambda].
     pub fn unknowns(&self) -> &[f64] {
         &self.x
@@ -588,6 +593,7 @@ impl Simulation {
     fn try_increment(&mut self, t_new: f64) -> Result<Trial> {
         // The factorization cache lives outside `self` while the context borrows it.
         let mut linear = std::mem::take(&mut self.linear);
+        linear.set_threads(super::assembly::worker_threads(self.model.settings.threads));
         let prediction = self.model.settings.status_prediction;
         let budget = self.model.settings.max_iterations;
         // Every attempt's time is the run's: a failed one's is counted here, an accepted

@@ -28,12 +28,22 @@
 //! scattered rows still costs about 60 % of a whole factorization on the square cup; what it
 //! is for is status prediction's re-solves, which change the rows of a few contact nodes.
 //!
+//! Threads: a supernode's panels depend on its own entries and its descendants' panels
+//! only, so disjoint subtrees of the elimination tree are factorized at once (each a
+//! contiguous range of supernodes, hence of the value array, cut apart without sharing), one thread per bin of subtrees of about equal recomputed flops
+//! ([`super::subtree_split`]), and the supernodes above them (the root separators) after
+//! them on one thread. Each supernode is computed by the same operations whatever thread
+//! runs it: the factors are bit for bit the sequential ones. Where two bins meet refused
+//! pivots, the one of least column is reported (the sequential order may stop at another
+//! one first; either way the call fails and the next factorization is whole).
+//!
 //! Without pivoting, a tiny pivot would spoil the factors: every diagonal pivot is checked
 //! against the largest entry of its column of `L` and row of `U` before elimination
 //! (`|u_jj| > 1e-10 max`), and the caller checks the backward error of the solution (see
 //! [`super::linear::SymmetricLu`]), falling back to a pivoting LU when either fails.
 
 use super::sparse::SparsePattern;
+use super::subtree_split::Forest;
 use crate::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::matmul::matmul;
@@ -95,6 +105,11 @@ pub struct SymbolicSymmetricLu {
     /// Identifies this analysis, so that numeric factors kept for a partial
     /// refactorization are never reused on another one.
     id: u64,
+    /// The supernodal elimination tree (a supernode's parent owns its first row below the
+    /// diagonal block; `None` if a parent came before its child, which faer's order never
+    /// does): disjoint subtrees can be factorized by different threads
+    /// ([`NumericSymmetricLu::set_threads`]).
+    forest: Option<Forest>,
 }
 
 static NEXT_ANALYSIS_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
@@ -215,7 +230,15 @@ impl SymbolicSymmetricLu {
             total_flops: 0.0,
             len,
             id: NEXT_ANALYSIS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            forest: None,
         };
+        let parent = (0..ns)
+            .map(|s| {
+                let (_, _, _, rows) = analysis.panels(s);
+                rows.first().map(|&g| col_super[g])
+            })
+            .collect();
+        analysis.forest = Forest::new(parent);
         analysis.flops = (0..ns)
             .map(|s| {
                 let (_, k, r, _) = analysis.panels(s);
@@ -374,20 +397,47 @@ pub struct PivotFailure {
 #[derive(Default)]
 pub struct NumericSymmetricLu {
     values: Vec<f64>,
-    position: Vec<usize>,
-    product: Vec<f64>,
+    /// One per thread of the factorization.
+    scratch: Vec<Scratch>,
+    /// The solves' permuted right-hand sides.
     work: Vec<f64>,
     /// The values of `A` that `values` are the complete factors of, and the analysis they
     /// were computed on: a later call recomputes only what differs ([`Self::factorize`]).
     factored: Vec<f64>,
     factored_on: Option<u64>,
     dirty: Vec<bool>,
+    /// Threads of the numeric factorization (0 or 1: this one).
+    threads: usize,
     /// Work of all calls and of the supernodes they recomputed (flops).
     pub flops_total: f64,
     pub flops_done: f64,
+    /// Calls that ran on several threads.
+    pub split_calls: usize,
 }
 
+/// What one thread of the factorization writes besides the factors.
+#[derive(Default)]
+struct Scratch {
+    /// Local row of each (permuted) unknown in the supernode being computed.
+    position: Vec<usize>,
+    /// A descendant's update.
+    product: Vec<f64>,
+    /// The pivot test's scale per column of the supernode.
+    column_max: Vec<f64>,
+}
+
+/// A factorization recomputing fewer flops than this runs on one thread, whatever
+/// [`NumericSymmetricLu::set_threads`] says: starting a thread costs about as much as
+/// 10^5-10^6 flops of the dense kernels (tens of microseconds).
+pub const PARALLEL_MIN_FLOPS: f64 = 5e6;
+
 impl NumericSymmetricLu {
+    /// Threads of the numeric factorization (module docs, "Threads"); the factors are the
+    /// same bit for bit whatever their number.
+    pub fn set_threads(&mut self, threads: usize) {
+        self.threads = threads;
+    }
+
     /// Factorizes the matrix with values `a` on the analysed pattern.
     ///
     /// When the factors of the previous call are complete and on the same analysis, only
@@ -435,98 +485,88 @@ impl NumericSymmetricLu {
                 self.values[k] = v;
             }
         }
-        self.position.resize(sy.n, 0);
         self.flops_total += sy.total_flops;
+        let mut recomputed = 0.0;
+        for s in (0..ns).filter(|&s| self.dirty[s]) {
+            recomputed += sy.flops[s];
+        }
+        self.flops_done += recomputed;
+        let threads = self.threads.max(1);
+        self.scratch.resize_with(threads, Scratch::default);
+        for scratch in &mut self.scratch {
+            scratch.position.resize(sy.n, 0);
+        }
+        let split = match &sy.forest {
+            Some(forest) if threads > 1 && recomputed >= PARALLEL_MIN_FLOPS => {
+                let work: Vec<f64> = (0..ns)
+                    .map(|s| if self.dirty[s] { sy.flops[s] } else { 0.0 })
+                    .collect();
+                forest.split(&work, threads)
+            }
+            _ => None,
+        };
+        let dirty = &self.dirty;
+        let mut in_subtree = vec![false; if split.is_some() { ns } else { 0 }];
+        if let Some(bins) = &split {
+            self.split_calls += 1;
+            // Each subtree's panels are one contiguous range of the value array:
+            // cut it into one slice per subtree, and compute the bins at once.
+            let mut ranges: Vec<(usize, usize, usize)> = bins
+                .iter()
+                .enumerate()
+                .flat_map(|(b, r)| r.iter().map(move |&(first, root)| (first, root, b)))
+                .collect();
+            ranges.sort_unstable();
+            let mut per_bin: Vec<Vec<(usize, usize, &mut [f64])>> =
+                (0..threads).map(|_| Vec::new()).collect();
+            let mut rest: &mut [f64] = &mut self.values;
+            let mut cut = 0;
+            for &(first, root, b) in &ranges {
+                in_subtree[first..=root].fill(true);
+                let (start, end) = (sy.offset[first], sy.offset[root + 1]);
+                let (_, tail) = std::mem::take(&mut rest).split_at_mut(start - cut);
+                let (piece, tail) = tail.split_at_mut(end - start);
+                rest = tail;
+                cut = end;
+                per_bin[b].push((first, root, piece));
+            }
+            let run = |pieces: Vec<(usize, usize, &mut [f64])>, scratch: &mut Scratch| {
+                for (first, root, piece) in pieces {
+                    let base = sy.offset[first];
+                    for s in (first..=root).filter(|&s| dirty[s]) {
+                        factor_supernode(sy, s, piece, base, scratch)?;
+                    }
+                }
+                Ok(())
+            };
+            let mut pieces = per_bin.into_iter();
+            let own = pieces.next().expect("threads >= 2");
+            let (first_scratch, others) = self.scratch.split_at_mut(1);
+            let results: Vec<std::result::Result<(), PivotFailure>> = std::thread::scope(|scope| {
+                let handles: Vec<_> = pieces
+                    .zip(others.iter_mut())
+                    .map(|(bin, scratch)| scope.spawn(move || run(bin, scratch)))
+                    .collect();
+                let mut results = vec![run(own, &mut first_scratch[0])];
+                results.extend(
+                    handles
+                        .into_iter()
+                        .map(|h| h.join().expect("a factorization thread panicked")),
+                );
+                results
+            });
+            // The refused pivot of least column, whichever thread met it.
+            if let Some(failure) = results
+                .into_iter()
+                .filter_map(|r| r.err())
+                .min_by_key(|f| f.column)
+            {
+                return Err(failure);
+            }
+        }
         for s in 0..ns {
-            if !self.dirty[s] {
-                continue;
-            }
-            self.flops_done += sy.flops[s];
-            let (f, k, r, rows) = sy.panels(s);
-            let m = k + r;
-            for j in 0..k {
-                self.position[f + j] = j;
-            }
-            for (p, &g) in rows.iter().enumerate() {
-                self.position[g] = k + p;
-            }
-            let (done, rest) = self.values.split_at_mut(sy.offset[s]);
-            let (l_panel, rest) = rest.split_at_mut(m * k);
-            let u_panel = &mut rest[..r * k];
-            for up in &sy.updates[sy.update_ptr[s]..sy.update_ptr[s + 1]] {
-                let (_, kd, rd, rows_d) = sy.panels(up.d);
-                let md = kd + rd;
-                let base = sy.offset[up.d];
-                let ld = MatRef::from_column_major_slice(&done[base..base + md * kd], md, kd);
-                let ud =
-                    MatRef::from_column_major_slice(&done[base + md * kd..][..rd * kd], rd, kd);
-                let (nr, nc) = (rd - up.p1, up.p2 - up.p1);
-                // L: rows p1.. of d times U's columns p1..p2.
-                let l_rows = ld.subrows(kd + up.p1, nr);
-                let u_cols = ud.subrows(up.p1, nc);
-                dense_product(&mut self.product, l_rows, u_cols, nr, nc);
-                for c in 0..nc {
-                    let col = rows_d[up.p1 + c] - f;
-                    let target = &mut l_panel[col * m..(col + 1) * m];
-                    for (i, &g) in rows_d[up.p1..].iter().enumerate() {
-                        target[self.position[g]] -= self.product[i + c * nr];
-                    }
-                }
-                // U^T: rows p2.. of d's U^T panel times L's rows p1..p2.
-                let nu = rd - up.p2;
-                if nu > 0 {
-                    let u_rows = ud.subrows(up.p2, nu);
-                    let l_cols = ld.subrows(kd + up.p1, nc);
-                    dense_product(&mut self.product, u_rows, l_cols, nu, nc);
-                    for c in 0..nc {
-                        let col = rows_d[up.p1 + c] - f;
-                        let target = &mut u_panel[col * r..(col + 1) * r];
-                        for (i, &g) in rows_d[up.p2..].iter().enumerate() {
-                            target[self.position[g] - k] -= self.product[i + c * nu];
-                        }
-                    }
-                }
-            }
-            // The pivot test's scale: the largest entry of the column of L and row of U.
-            self.work.clear();
-            for j in 0..k {
-                // Column j of L from the diagonal down, row j of U right of the diagonal.
-                let column = l_panel[j * m + j..(j + 1) * m].iter();
-                let row = (j + 1..k).map(|c| &l_panel[c * m + j]);
-                let row_beyond = u_panel[j * r..(j + 1) * r].iter();
-                let max = column
-                    .chain(row)
-                    .chain(row_beyond)
-                    .fold(0.0f64, |a, v| a.max(v.abs()));
-                self.work.push(max);
-            }
-            let mut panel = MatMut::from_column_major_slice_mut(l_panel, m, k);
-            let (mut diagonal, _, mut below, _) = panel.rb_mut().split_at_mut(k, k);
-            lu_no_pivoting(diagonal.rb_mut());
-            for j in 0..k {
-                let pivot = diagonal[(j, j)];
-                if !(pivot.is_finite() && pivot.abs() > PIVOT_TOLERANCE * self.work[j]) {
-                    return Err(PivotFailure {
-                        column: f + j,
-                        pivot,
-                        column_max: self.work[j],
-                    });
-                }
-            }
-            if r > 0 {
-                // L_Rs U_ss = A_Rs  <=>  U_ss^T L_Rs^T = A_Rs^T.
-                solve_lower_triangular_in_place(
-                    diagonal.rb().transpose(),
-                    below.rb_mut().transpose_mut(),
-                    Par::Seq,
-                );
-                // L_ss U_sR = A_sR, with U_sR^T stored.
-                let mut ut = MatMut::from_column_major_slice_mut(u_panel, r, k);
-                solve_unit_lower_triangular_in_place(
-                    diagonal.rb(),
-                    ut.rb_mut().transpose_mut(),
-                    Par::Seq,
-                );
+            if dirty[s] && !in_subtree.get(s).copied().unwrap_or(false) {
+                factor_supernode(sy, s, &mut self.values, 0, &mut self.scratch[0])?;
             }
         }
         self.factored.clear();
@@ -595,6 +635,103 @@ impl NumericSymmetricLu {
             }
         }
     }
+}
+
+/// Computes supernode `s`'s panels (module docs, "numeric") in `values`, the value array
+/// from index `base` on, which holds `s`'s panels and those of its descendants: gathers
+/// their updates, factorizes the diagonal block without pivoting (refusing a pivot below
+/// [`PIVOT_TOLERANCE`] of its column of L and row of U) and solves for the off-diagonal
+/// panels. The same operations in the same order wherever it runs, so the factors do not
+/// depend on the threads.
+fn factor_supernode(
+    sy: &SymbolicSymmetricLu,
+    s: usize,
+    values: &mut [f64],
+    base: usize,
+    scratch: &mut Scratch,
+) -> std::result::Result<(), PivotFailure> {
+    let (f, k, r, rows) = sy.panels(s);
+    let m = k + r;
+    for j in 0..k {
+        scratch.position[f + j] = j;
+    }
+    for (p, &g) in rows.iter().enumerate() {
+        scratch.position[g] = k + p;
+    }
+    let (done, rest) = values.split_at_mut(sy.offset[s] - base);
+    let (l_panel, rest) = rest.split_at_mut(m * k);
+    let u_panel = &mut rest[..r * k];
+    for up in &sy.updates[sy.update_ptr[s]..sy.update_ptr[s + 1]] {
+        let (_, kd, rd, rows_d) = sy.panels(up.d);
+        let md = kd + rd;
+        let at = sy.offset[up.d] - base;
+        let ld = MatRef::from_column_major_slice(&done[at..at + md * kd], md, kd);
+        let ud = MatRef::from_column_major_slice(&done[at + md * kd..][..rd * kd], rd, kd);
+        let (nr, nc) = (rd - up.p1, up.p2 - up.p1);
+        // L: rows p1.. of d times U's columns p1..p2.
+        let l_rows = ld.subrows(kd + up.p1, nr);
+        let u_cols = ud.subrows(up.p1, nc);
+        dense_product(&mut scratch.product, l_rows, u_cols, nr, nc);
+        for c in 0..nc {
+            let col = rows_d[up.p1 + c] - f;
+            let target = &mut l_panel[col * m..(col + 1) * m];
+            for (i, &g) in rows_d[up.p1..].iter().enumerate() {
+                target[scratch.position[g]] -= scratch.product[i + c * nr];
+            }
+        }
+        // U^T: rows p2.. of d's U^T panel times L's rows p1..p2.
+        let nu = rd - up.p2;
+        if nu > 0 {
+            let u_rows = ud.subrows(up.p2, nu);
+            let l_cols = ld.subrows(kd + up.p1, nc);
+            dense_product(&mut scratch.product, u_rows, l_cols, nu, nc);
+            for c in 0..nc {
+                let col = rows_d[up.p1 + c] - f;
+                let target = &mut u_panel[col * r..(col + 1) * r];
+                for (i, &g) in rows_d[up.p2..].iter().enumerate() {
+                    target[scratch.position[g] - k] -= scratch.product[i + c * nu];
+                }
+            }
+        }
+    }
+    // The pivot test's scale: the largest entry of the column of L and row of U.
+    scratch.column_max.clear();
+    for j in 0..k {
+        // Column j of L from the diagonal down, row j of U right of the diagonal.
+        let column = l_panel[j * m + j..(j + 1) * m].iter();
+        let row = (j + 1..k).map(|c| &l_panel[c * m + j]);
+        let row_beyond = u_panel[j * r..(j + 1) * r].iter();
+        let max = column
+            .chain(row)
+            .chain(row_beyond)
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        scratch.column_max.push(max);
+    }
+    let mut panel = MatMut::from_column_major_slice_mut(l_panel, m, k);
+    let (mut diagonal, _, mut below, _) = panel.rb_mut().split_at_mut(k, k);
+    lu_no_pivoting(diagonal.rb_mut());
+    for j in 0..k {
+        let pivot = diagonal[(j, j)];
+        if !(pivot.is_finite() && pivot.abs() > PIVOT_TOLERANCE * scratch.column_max[j]) {
+            return Err(PivotFailure {
+                column: f + j,
+                pivot,
+                column_max: scratch.column_max[j],
+            });
+        }
+    }
+    if r > 0 {
+        // L_Rs U_ss = A_Rs  <=>  U_ss^T L_Rs^T = A_Rs^T.
+        solve_lower_triangular_in_place(
+            diagonal.rb().transpose(),
+            below.rb_mut().transpose_mut(),
+            Par::Seq,
+        );
+        // L_ss U_sR = A_sR, with U_sR^T stored.
+        let mut ut = MatMut::from_column_major_slice_mut(u_panel, r, k);
+        solve_unit_lower_triangular_in_place(diagonal.rb(), ut.rb_mut().transpose_mut(), Par::Seq);
+    }
+    Ok(())
 }
 
 /// `out (rows x cols, column-major) = a b^T` for `a` (rows x k) and `b` (cols x k). Small
@@ -802,6 +939,99 @@ mod tests {
 
     /// After a refused pivot the kept factors are incomplete: the next call factorizes
     /// everything.
+    /// The factorization on 2, 3 and 4 threads (disjoint subtrees at once, the top after
+    /// them) gives the sequential factors bit for bit, whole and partial, and so the same
+    /// solutions; a matrix large enough that the split runs (its recomputed flops above
+    /// `PARALLEL_MIN_FLOPS`), and one change of a few rows for the partial call.
+    #[test]
+    fn threads_give_the_sequential_factors_bit_for_bit() {
+        let a = random_matrix(6000, 41);
+        let sy = SymbolicSymmetricLu::new(&a.pattern).unwrap();
+        assert!(
+            sy.forest.is_some(),
+            "faer's supernodes come after their children"
+        );
+        let mut changed = a.clone();
+        for (k, v) in changed.values.iter_mut().enumerate() {
+            let r = changed.pattern.row_idx[k];
+            if r % 997 == 3 {
+                *v *= 1.25;
+            }
+        }
+        let mut sequential = NumericSymmetricLu::default();
+        sequential.factorize(&sy, &a.values).unwrap();
+        assert!(
+            sequential.flops_done >= super::PARALLEL_MIN_FLOPS,
+            "{}",
+            sequential.flops_done
+        );
+        let whole = sequential.values.clone();
+        sequential.factorize(&sy, &changed.values).unwrap();
+        let partial = sequential.values.clone();
+        let b: Vec<f64> = (0..6000).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut x_seq = b.clone();
+        sequential.solve_in_place(&sy, &mut x_seq, 1);
+        for threads in [2, 3, 4] {
+            let mut parallel = NumericSymmetricLu::default();
+            parallel.set_threads(threads);
+            let split = sy
+                .forest
+                .as_ref()
+                .unwrap()
+                .split(&sy.flops, threads)
+                .expect("the tree splits");
+            assert!(split.iter().all(|bin| !bin.is_empty()));
+            parallel.factorize(&sy, &a.values).unwrap();
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(
+                bits(&parallel.values),
+                bits(&whole),
+                "{threads} threads, whole"
+            );
+            let done = parallel.flops_done;
+            parallel.factorize(&sy, &changed.values).unwrap();
+            assert!(parallel.flops_done - done < sy.total_flops, "partial");
+            assert_eq!(
+                bits(&parallel.values),
+                bits(&partial),
+                "{threads} threads, partial"
+            );
+            let mut x = b.clone();
+            parallel.solve_in_place(&sy, &mut x, 1);
+            assert_eq!(bits(&x), bits(&x_seq));
+        }
+    }
+
+    /// A refused pivot inside a subtree computed by a second thread is reported as on one
+    /// thread, and leaves the next factorization whole.
+    #[test]
+    fn a_refused_pivot_in_a_thread_fails_the_call() {
+        let a = random_matrix(6000, 43);
+        let sy = SymbolicSymmetricLu::new(&a.pattern).unwrap();
+        let mut bad = a.clone();
+        // Zero the first unknown's row and column in the factor order: its supernode is a
+        // leaf, in some bin.
+        let first = sy.perm[0];
+        for c in 0..6000 {
+            for k in bad.pattern.col_ptr[c]..bad.pattern.col_ptr[c + 1] {
+                if c == first || bad.pattern.row_idx[k] == first {
+                    bad.values[k] = 0.0;
+                }
+            }
+        }
+        let mut sequential = NumericSymmetricLu::default();
+        let expected = sequential.factorize(&sy, &bad.values).unwrap_err();
+        let mut parallel = NumericSymmetricLu::default();
+        parallel.set_threads(2);
+        let failure = parallel.factorize(&sy, &bad.values).unwrap_err();
+        assert_eq!(failure.column, expected.column);
+        assert_eq!(failure.column, 0);
+        parallel.factorize(&sy, &a.values).unwrap();
+        sequential.factorize(&sy, &a.values).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&parallel.values), bits(&sequential.values));
+    }
+
     #[test]
     fn a_refused_pivot_makes_the_next_factorization_whole() {
         let a = random_matrix(300, 13);
