@@ -102,21 +102,26 @@ impl Forest {
                 subtree[p] += subtree[s];
             }
         }
-        // Subtrees with work, non-contiguous ones opened (their roots on top).
+        // Adds the subtrees of `nodes` with work to `frontier`, opening the non-contiguous
+        // ones (their roots' work to `top`).
+        let add = |nodes: Vec<usize>, frontier: &mut Vec<usize>, top: &mut f64| {
+            let mut open = nodes;
+            while let Some(s) = open.pop() {
+                if subtree[s] <= 0.0 {
+                    continue;
+                }
+                if self.contiguous[s] {
+                    frontier.push(s);
+                } else {
+                    *top += work[s];
+                    open.extend(self.children(s));
+                }
+            }
+        };
         let mut top = 0.0;
         let mut frontier = Vec::new();
-        let mut open: Vec<usize> = (0..n).filter(|&s| self.parent[s].is_none()).collect();
-        while let Some(s) = open.pop() {
-            if subtree[s] <= 0.0 {
-                continue;
-            }
-            if self.contiguous[s] {
-                frontier.push(s);
-            } else {
-                top += work[s];
-                open.extend(self.children(s));
-            }
-        }
+        let roots = (0..n).filter(|&s| self.parent[s].is_none()).collect();
+        add(roots, &mut frontier, &mut top);
         frontier.sort_unstable();
         // The parallel time of a frontier, bounded below: the top's work plus the larger of
         // the largest subtree and an even share.
@@ -137,18 +142,11 @@ impl Forest {
             let mut opened = frontier.clone();
             opened.swap_remove(at);
             let mut opened_top = top + work[largest];
-            let mut open: Vec<usize> = self.children(largest).collect();
-            while let Some(c) = open.pop() {
-                if subtree[c] <= 0.0 {
-                    continue;
-                }
-                if self.contiguous[c] {
-                    opened.push(c);
-                } else {
-                    opened_top += work[c];
-                    open.extend(self.children(c));
-                }
-            }
+            add(
+                self.children(largest).collect(),
+                &mut opened,
+                &mut opened_top,
+            );
             if cost(&opened, opened_top) >= cost(&frontier, top) {
                 break;
             }
