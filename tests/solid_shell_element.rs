@@ -3,7 +3,7 @@
 
 use nalgebra::{DMatrix, DVector, Rotation3};
 use tribo::element::hex8::shape_functions;
-use tribo::element::{Element, SolidShell};
+use tribo::element::{Element, LocalSolve, SolidShell};
 use tribo::geometry::{Mat3, Vec3};
 use tribo::material::{
     stress_to_tensor, ElastoPlastic, Hardening, Hill48, LinearElastic, Material, PointState,
@@ -437,8 +437,9 @@ fn rigid_rotation_of_a_plastic_element_is_objective() {
 /// local solution, round-off, and must agree to 1e-12 (round-off times the conditioning
 /// of the condensation, with room); the stiffness is the tangent at the last local iterate,
 /// `δ` away, and must agree to 1e-6 (the tolerance times the tangent's rate of change, with
-/// room). A residual-only call leaves the memory as it was; a call with the stiffness
-/// writes it.
+/// room). From a prediction it may stop at 1e-4 and then says so (`LocalSolve::Approximate`,
+/// bounds of `a_predicted_local_solve_stops_early_and_says_so`). A residual-only call leaves
+/// the memory as it was; a call with the stiffness writes it.
 #[test]
 fn tuned_kernel_equals_the_original() {
     let x = distorted_element();
@@ -503,18 +504,20 @@ fn tuned_kernel_equals_the_original() {
                     t.enhanced = s.enhanced;
                 }
                 let (mut f, mut k) = (vec![0.0; 24], vec![0.0; 576]);
+                let mut solve = LocalSolve::Exact;
                 if start == "predicted" {
-                    el.evaluate_remembering(
-                        &x,
-                        &at(1.0),
-                        &committed,
-                        &mut trial,
-                        m,
-                        &mut memory,
-                        &mut f,
-                        Some(&mut k),
-                    )
-                    .unwrap();
+                    solve = el
+                        .evaluate_remembering(
+                            &x,
+                            &at(1.0),
+                            &committed,
+                            &mut trial,
+                            m,
+                            &mut memory,
+                            &mut f,
+                            Some(&mut k),
+                        )
+                        .unwrap();
                     assert!(relative(&f, &f_trial) < 1e-12, "residual-only = full");
                     assert_ne!(memory, remembered, "a call with the stiffness remembers");
                 } else {
@@ -556,16 +559,101 @@ fn tuned_kernel_equals_the_original() {
                     .fold(0.0, f64::max);
                 let da = relative(&trial[0].enhanced, &trial_ref[0].enhanced);
                 println!(
-                    "finite {finite} {name} {start}: force {df:.1e}, stiffness {dk:.1e}, \
-                     stresses {ds:.1e}, enhanced {da:.1e}, plastic strain {dp:.1e}"
+                    "finite {finite} {name} {start} ({solve:?}): force {df:.1e}, stiffness \
+                     {dk:.1e}, stresses {ds:.1e}, enhanced {da:.1e}, plastic strain {dp:.1e}"
                 );
-                assert!(df < 1e-12 && ds < 1e-12 && da < 1e-12);
+                // A call that stopped early from its prediction (step up to 1e-4 of the
+                // strain scale) is within the square of that, with room: 1e-7.
+                let bound = match solve {
+                    LocalSolve::Exact => 1e-12,
+                    LocalSolve::Approximate => 1e-7,
+                };
+                assert!(df < bound && ds < bound && da < bound);
                 // The tangent and the material's internal variables are those of the last
-                // local iterate: `δ` (<= 1e-8 of the strain scale, <= 1e-2 here) away.
-                assert!(dk < 1e-6 && dp < 1e-10);
+                // local iterate: `δ` away, at most 1e-8 of the strain scale (<= 1e-2 here)
+                // when exact, 1e-4 when approximate (measured 3e-6 and 3.5e-7).
+                let (k_bound, p_bound) = match solve {
+                    LocalSolve::Exact => (1e-6, 1e-10),
+                    LocalSolve::Approximate => (1e-4, 2e-6),
+                };
+                assert!(dk < k_bound && dp < p_bound);
             }
         }
     }
+}
+
+/// A local solve started from the linearised prediction of a memory stops once its step is
+/// 1e-4 of the strain scale (`PREDICTED_LOCAL_TOLERANCE`) and says whether that was beyond
+/// the tight 1e-8 (`LocalSolve::Approximate`): from a memory far from the displacements the
+/// call is approximate, its force within the square of the looser stop (1e-8, with room
+/// 1e-7) of the reference kernel's; from a memory close by it is exact (1e-12). Plastic
+/// Hill48 under finite rotation, the distorted element.
+#[test]
+fn a_predicted_local_solve_stops_early_and_says_so() {
+    let x = distorted_element();
+    let rot = Rotation3::from_euler_angles(0.5, -0.8, 0.6).into_inner();
+    let mut rng = Lcg(29);
+    let strain: [Vec3; 8] = std::array::from_fn(|_| rng.vec() * 0.004);
+    let at = |f: f64| -> [Vec3; 8] { std::array::from_fn(|a| rot * (x[a] + strain[a] * f) - x[a]) };
+    let plastic = hill_swift();
+    let el = shell(true);
+    let virgin = vec![PointState::default(); el.point_count()];
+    let (_, _, committed) = evaluate(&el, &x, &at(0.6), &virgin, &plastic);
+    let mut trial_ref = committed.clone();
+    let (mut f_ref, mut k_ref) = (vec![0.0; 24], vec![0.0; 576]);
+    tribo::element::solid_shell_reference::evaluate_into(
+        &el,
+        &x,
+        &at(1.0),
+        &committed,
+        &mut trial_ref,
+        &plastic,
+        &mut f_ref,
+        Some(&mut k_ref),
+    )
+    .unwrap();
+    let mut kinds = Vec::new();
+    for from in [0.7, 0.9, 0.97, 0.999, 0.99999] {
+        let mut memory = vec![f64::NAN; el.memory_len()];
+        let (mut f, mut k) = (vec![0.0; 24], vec![0.0; 576]);
+        el.evaluate_remembering(
+            &x,
+            &at(from),
+            &committed,
+            &mut committed.clone(),
+            &plastic,
+            &mut memory,
+            &mut f,
+            Some(&mut k),
+        )
+        .unwrap();
+        let mut trial = committed.clone();
+        let solve = el
+            .evaluate_remembering(
+                &x,
+                &at(1.0),
+                &committed,
+                &mut trial,
+                &plastic,
+                &mut memory,
+                &mut f,
+                None,
+            )
+            .unwrap();
+        let df = relative(&f, &f_ref);
+        println!("memory at {from}: {solve:?}, force {df:.1e}");
+        let bound = match solve {
+            LocalSolve::Exact => 1e-12,
+            LocalSolve::Approximate => 1e-7,
+        };
+        assert!(
+            df < bound,
+            "memory at {from}: {solve:?}, force off by {df:e}"
+        );
+        kinds.push(solve);
+    }
+    assert!(kinds.contains(&LocalSolve::Approximate), "{kinds:?}");
+    assert_eq!(kinds.last(), Some(&LocalSolve::Exact), "{kinds:?}");
 }
 
 /// The local EAS iteration where full Newton steps fail: a virgin flange element of the

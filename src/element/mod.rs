@@ -90,6 +90,19 @@ pub struct ElementResponse<const D: usize> {
     pub stiffness: SMatrix<f64, D, D>,
 }
 
+/// How an element call solved the element's own unknowns (the solid-shell's enhanced
+/// parameters); elements without any are always exact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LocalSolve {
+    /// To the element's tight tolerance: forces and states a function of the displacements
+    /// and the committed state to round-off.
+    Exact,
+    /// Stopped earlier from a linearised prediction: forces off the exact local solution by
+    /// a bounded amount (the solid-shell: `O(δ²)`, `δ <= 1e-4` of its strain scale), fine for
+    /// a Newton iterate, not for a converged state (Newton does not accept one).
+    Approximate,
+}
+
 /// A finite element with `D` degrees of freedom (3 per node).
 ///
 /// Every method takes the *reference* nodal coordinates, and `evaluate` the *total*
@@ -155,7 +168,10 @@ pub trait Element<const D: usize>: std::fmt::Debug + Send + Sync {
     /// [`Self::evaluate_into`] with the element's `memory` (length [`Self::memory_len`]; all
     /// NaN at the start of an attempt), which it may read to start from and writes with a
     /// `stiffness` only: line-search trials leave it as the last linearisation left it. The
-    /// result depends on it at round-off at most. The default ignores it.
+    /// result depends on it at round-off at most where the call returns
+    /// [`LocalSolve::Exact`]; an element with internal unknowns may stop their solve
+    /// earlier from a good start and say so ([`LocalSolve::Approximate`]). The default
+    /// ignores the memory.
     #[allow(clippy::too_many_arguments)]
     fn evaluate_remembering(
         &self,
@@ -167,9 +183,10 @@ pub trait Element<const D: usize>: std::fmt::Debug + Send + Sync {
         memory: &mut [f64],
         force: &mut [f64],
         stiffness: Option<&mut [f64]>,
-    ) -> Result<()> {
+    ) -> Result<LocalSolve> {
         let _ = memory;
-        self.evaluate_into(ref_coords, u, committed, trial, material, force, stiffness)
+        self.evaluate_into(ref_coords, u, committed, trial, material, force, stiffness)?;
+        Ok(LocalSolve::Exact)
     }
 
     /// Reference volume weight `w_g det J_g` of each integration point.

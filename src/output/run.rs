@@ -484,6 +484,7 @@ impl RunOutput {
                 "full": sim.phase_times.full_evaluations,
                 "residual_only": sim.phase_times.residual_evaluations,
                 "jacobian_completions": sim.phase_times.jacobian_completions,
+                "with_approximate_local_solves": sim.phase_times.approximate_evaluations,
             },
             "kinematics": settings.kinematics.name(),
             "nodes": sim.model.mesh.nodes.len(),

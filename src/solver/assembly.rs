@@ -20,7 +20,7 @@ use crate::contact::{
     alart_curnier, BernsteinLaw, ContactNodeState, Enforcement, FrictionUpdate, NodalContact,
     OperatorParams,
 };
-use crate::element::in_element;
+use crate::element::{in_element, LocalSolve};
 use crate::geometry::{Mat3, Projection, Vec3};
 use crate::material::PointState;
 use crate::tool::pose::Pose;
@@ -138,6 +138,8 @@ pub(super) fn worker_threads(setting: usize) -> usize {
 struct ElementBuffers {
     force: Vec<f64>,
     stiffness: Vec<f64>,
+    /// Elements whose call stopped their local solve early ([`LocalSolve::Approximate`]).
+    approximate: usize,
 }
 
 /// What the elements remember between the evaluations of one Newton attempt
@@ -179,6 +181,7 @@ fn evaluate_elements(
     let mut buffers = ElementBuffers {
         force: vec![0.0; n_elem * D],
         stiffness: vec![0.0; if tangent { n_elem * D * D } else { 0 }],
+        approximate: 0,
     };
     let evaluate_block = |first: usize,
                           trial: &mut [PointState],
@@ -188,6 +191,7 @@ fn evaluate_elements(
         let mut xs = [Vec3::zeros(); 8];
         let mut us = [Vec3::zeros(); 8];
         let mut stiffness = tangent.then(|| stiffness.chunks_mut(D * D));
+        let mut approximate = 0;
         for (k, (trial_e, force_e)) in trial
             .chunks_mut(per_elem)
             .zip(force.chunks_mut(D))
@@ -201,7 +205,7 @@ fn evaluate_elements(
             let committed_e = &committed[e * per_elem..(e + 1) * per_elem];
             let stiffness_e = stiffness.as_mut().and_then(|s| s.next());
             let memory_e = &mut memory[k * remembers..(k + 1) * remembers];
-            element
+            let solve = element
                 .evaluate_remembering(
                     &xs,
                     &us,
@@ -218,8 +222,9 @@ fn evaluate_elements(
                     err @ Error::NoConvergence(_) => err,
                     other => Error::NoConvergence(other.to_string()),
                 })?;
+            approximate += usize::from(solve == LocalSolve::Approximate);
         }
-        Ok::<_, Error>(())
+        Ok::<_, Error>(approximate)
     };
     // A failed evaluation leaves the memory as it was: else which elements had written
     // theirs before the failure would depend on the thread count.
@@ -250,7 +255,8 @@ fn evaluate_elements(
     if let (Err(_), Some(before)) = (&outcome, before) {
         *memory = before;
     }
-    outcome.map(|()| buffers)
+    buffers.approximate = outcome?;
+    Ok(buffers)
 }
 
 /// The element loop of [`evaluate_elements`] on `threads` threads, over contiguous blocks
@@ -266,9 +272,9 @@ fn evaluate_on_threads<F>(
     buffers: &mut ElementBuffers,
     memory: &mut [f64],
     evaluate_block: &F,
-) -> Result<()>
+) -> Result<usize>
 where
-    F: Fn(usize, &mut [PointState], &mut [f64], &mut [f64], &mut [f64]) -> Result<()> + Sync,
+    F: Fn(usize, &mut [PointState], &mut [f64], &mut [f64], &mut [f64]) -> Result<usize> + Sync,
 {
     const D: usize = crate::element::hex8::DOFS;
     let block = n_elem.div_ceil(threads);
@@ -282,7 +288,7 @@ where
         memory.chunks_mut(block * remembers).collect()
     };
     memory_chunks.resize_with(n_elem.div_ceil(block), Default::default);
-    let results: Vec<Result<()>> = std::thread::scope(|scope| {
+    let results: Vec<Result<usize>> = std::thread::scope(|scope| {
         let handles: Vec<_> = trial
             .chunks_mut(block * per_elem)
             .zip(buffers.force.chunks_mut(block * D))
@@ -298,7 +304,7 @@ where
             .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
     });
-    results.into_iter().collect()
+    results.into_iter().sum()
 }
 
 /// Wall time spent in each phase of assembly (seconds), and the evaluations made,
@@ -315,6 +321,9 @@ pub struct PhaseTimes {
     /// Residual-only evaluations given their Jacobian afterwards
     /// ([`IncrementContext::complete`]: element tangents and assembly, no contact pass).
     pub jacobian_completions: usize,
+    /// Evaluations (full or residual-only) in which some element stopped its local solve
+    /// early ([`LocalSolve::Approximate`]).
+    pub approximate_evaluations: usize,
 }
 
 impl PhaseTimes {
@@ -326,6 +335,7 @@ impl PhaseTimes {
         self.full_evaluations += other.full_evaluations;
         self.residual_evaluations += other.residual_evaluations;
         self.jacobian_completions += other.jacobian_completions;
+        self.approximate_evaluations += other.approximate_evaluations;
     }
 }
 
@@ -355,6 +365,9 @@ pub struct Evaluation {
     /// the contact part can be linearised again at the same unknowns without running the
     /// elements again ([`IncrementContext::relinearised`]).
     pub element_jacobian: Option<Vec<f64>>,
+    /// Elements whose local solve stopped early ([`LocalSolve::Approximate`]): a Newton
+    /// iterate may have them, a converged state may not.
+    pub approximate_elements: usize,
 }
 
 impl Evaluation {
@@ -393,6 +406,7 @@ struct ElementPart {
     jacobian: SparseMatrix,
     f_int: Vec<f64>,
     trial_points: Vec<PointState>,
+    approximate_elements: usize,
 }
 
 impl IncrementContext<'_> {
@@ -522,6 +536,7 @@ impl IncrementContext<'_> {
             },
             f_int: eval.f_int.clone(),
             trial_points: eval.trial_points.clone(),
+            approximate_elements: eval.approximate_elements,
         };
         // The projections depend on x and the committed hints only: those of `eval`.
         self.with_contact(x, part, times, true, Some(eval))
@@ -625,10 +640,12 @@ impl IncrementContext<'_> {
             slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
         }
         times.elements += t0.elapsed().as_secs_f64();
+        times.approximate_evaluations += usize::from(elements.approximate > 0);
         Ok(ElementPart {
             jacobian: jac,
             f_int,
             trial_points,
+            approximate_elements: elements.approximate,
         })
     }
 
@@ -649,6 +666,7 @@ impl IncrementContext<'_> {
             jacobian: mut jac,
             f_int,
             trial_points,
+            approximate_elements,
         } = part;
         let element_jacobian =
             (with_jacobian && self.keep_element_jacobian).then(|| jac.values.clone());
@@ -790,6 +808,7 @@ impl IncrementContext<'_> {
             f_ext,
             support_forces,
             element_jacobian,
+            approximate_elements,
         })
     }
 }

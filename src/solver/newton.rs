@@ -364,7 +364,10 @@ impl Simulation {
             }
             let force_ok = rec.force <= settings.force_rel_tol * reference
                 || rec.force <= settings.force_abs_tol;
-            if force_ok && rec.contact <= settings.contact_tol {
+            // An element whose local solve stopped early (an inexact iterate, see
+            // `LocalSolve`) keeps Newton going: the next, smaller step makes it exact, so a
+            // converged state is always the tight local tolerance's.
+            if force_ok && rec.contact <= settings.contact_tol && eval.approximate_elements == 0 {
                 // Converged with frozen statuses: only the free law's solution counts, so
                 // Newton goes on unfrozen from this state, near the solution. After the
                 // last allowed release nothing is frozen again, so no frozen state is
