@@ -73,6 +73,42 @@ fn evaluate(
     )
 }
 
+/// The reference kernel (`element::solid_shell_reference`, local solve to 1e-14) at `u`:
+/// force, stiffness (column-major) and point states.
+fn reference(
+    el: &SolidShell,
+    x: &[Vec3; 8],
+    u: &[Vec3; 8],
+    committed: &[PointState],
+    m: &dyn Material,
+) -> (Vec<f64>, Vec<f64>, Vec<PointState>) {
+    let mut trial = committed.to_vec();
+    let (mut f, mut k) = (vec![0.0; 24], vec![0.0; 576]);
+    tribo::element::solid_shell_reference::evaluate_into(
+        el,
+        x,
+        u,
+        committed,
+        &mut trial,
+        m,
+        &mut f,
+        Some(&mut k),
+    )
+    .unwrap();
+    (f, k, trial)
+}
+
+/// How far a tuned call's force, stresses and enhanced parameters may be from the reference
+/// kernel's, relative: round-off with room where its local solve was exact; where it
+/// stopped early from its prediction (step up to 1e-4 of the strain scale), the square of
+/// that, with room.
+fn force_bound(solve: LocalSolve) -> f64 {
+    match solve {
+        LocalSolve::Exact => 1e-12,
+        LocalSolve::Approximate => 1e-7,
+    }
+}
+
 /// Largest absolute entry of `a`.
 fn largest(a: &[f64]) -> f64 {
     a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
@@ -532,19 +568,7 @@ fn tuned_kernel_equals_the_original() {
                     )
                     .unwrap();
                 }
-                let mut trial_ref = committed.clone();
-                let (mut f_ref, mut k_ref) = (vec![0.0; 24], vec![0.0; 576]);
-                tribo::element::solid_shell_reference::evaluate_into(
-                    &el,
-                    &x,
-                    &at(1.0),
-                    &committed,
-                    &mut trial_ref,
-                    m,
-                    &mut f_ref,
-                    Some(&mut k_ref),
-                )
-                .unwrap();
+                let (f_ref, k_ref, trial_ref) = reference(&el, &x, &at(1.0), &committed, m);
                 let df = relative(&f, &f_ref);
                 let dk = relative(&k, &k_ref);
                 let ds = trial
@@ -562,12 +586,7 @@ fn tuned_kernel_equals_the_original() {
                     "finite {finite} {name} {start} ({solve:?}): force {df:.1e}, stiffness \
                      {dk:.1e}, stresses {ds:.1e}, enhanced {da:.1e}, plastic strain {dp:.1e}"
                 );
-                // A call that stopped early from its prediction (step up to 1e-4 of the
-                // strain scale) is within the square of that, with room: 1e-7.
-                let bound = match solve {
-                    LocalSolve::Exact => 1e-12,
-                    LocalSolve::Approximate => 1e-7,
-                };
+                let bound = force_bound(solve);
                 assert!(df < bound && ds < bound && da < bound);
                 // The tangent and the material's internal variables are those of the last
                 // local iterate: `δ` away, at most 1e-8 of the strain scale (<= 1e-2 here)
@@ -599,19 +618,7 @@ fn a_predicted_local_solve_stops_early_and_says_so() {
     let el = shell(true);
     let virgin = vec![PointState::default(); el.point_count()];
     let (_, _, committed) = evaluate(&el, &x, &at(0.6), &virgin, &plastic);
-    let mut trial_ref = committed.clone();
-    let (mut f_ref, mut k_ref) = (vec![0.0; 24], vec![0.0; 576]);
-    tribo::element::solid_shell_reference::evaluate_into(
-        &el,
-        &x,
-        &at(1.0),
-        &committed,
-        &mut trial_ref,
-        &plastic,
-        &mut f_ref,
-        Some(&mut k_ref),
-    )
-    .unwrap();
+    let (f_ref, _, _) = reference(&el, &x, &at(1.0), &committed, &plastic);
     let mut kinds = Vec::new();
     for from in [0.7, 0.9, 0.97, 0.999, 0.99999] {
         let mut memory = vec![f64::NAN; el.memory_len()];
@@ -642,12 +649,8 @@ fn a_predicted_local_solve_stops_early_and_says_so() {
             .unwrap();
         let df = relative(&f, &f_ref);
         println!("memory at {from}: {solve:?}, force {df:.1e}");
-        let bound = match solve {
-            LocalSolve::Exact => 1e-12,
-            LocalSolve::Approximate => 1e-7,
-        };
         assert!(
-            df < bound,
+            df < force_bound(solve),
             "memory at {from}: {solve:?}, force off by {df:e}"
         );
         kinds.push(solve);

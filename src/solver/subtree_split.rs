@@ -11,10 +11,9 @@
 //! postorder: a subtree whose nodes are not one contiguous range `first..=root` (faer's
 //! supernodal amalgamation leaves a few) is always opened. The split: starting from the
 //! roots, the subtree of largest work is replaced by its children (its root joins the top)
-//! while that lowers the bound `top + max(largest
-//! subtree, all subtrees / bins)` on the parallel time, at most [`MAX_EXPANSIONS`] times;
-//! the subtrees are then packed largest first into the bin of least work (LPT).
-//! O(expansions x frontier + nodes).
+//! while that lowers the bound `top + max(largest subtree, all subtrees / bins)` on the
+//! parallel time, at most [`MAX_EXPANSIONS`] times; the subtrees are then packed largest
+//! first into the bin of least work (LPT). O(expansions x frontier + nodes).
 
 /// How many subtree roots the split may move to the top. A tree whose work sits in a long
 /// chain of separators (where no split helps) stops there.

@@ -30,7 +30,8 @@
 //!
 //! Threads: a supernode's panels depend on its own entries and its descendants' panels
 //! only, so disjoint subtrees of the elimination tree are factorized at once (each a
-//! contiguous range of supernodes, hence of the value array, cut apart without sharing), one thread per bin of subtrees of about equal recomputed flops
+//! contiguous range of supernodes, hence of the value array, cut apart without sharing),
+//! one thread per bin of subtrees of about equal recomputed flops
 //! ([`super::subtree_split`]), and the supernodes above them (the root separators) after
 //! them on one thread. Each supernode is computed by the same operations whatever thread
 //! runs it: the factors are bit for bit the sequential ones. Where two bins meet refused
@@ -506,7 +507,7 @@ impl NumericSymmetricLu {
             _ => None,
         };
         let dirty = &self.dirty;
-        let mut in_subtree = vec![false; if split.is_some() { ns } else { 0 }];
+        let mut in_subtree = vec![false; ns];
         if let Some(bins) = &split {
             self.split_calls += 1;
             // Each subtree's panels are one contiguous range of the value array:
@@ -565,7 +566,7 @@ impl NumericSymmetricLu {
             }
         }
         for s in 0..ns {
-            if dirty[s] && !in_subtree.get(s).copied().unwrap_or(false) {
+            if dirty[s] && !in_subtree[s] {
                 factor_supernode(sy, s, &mut self.values, 0, &mut self.scratch[0])?;
             }
         }
