@@ -331,3 +331,39 @@ fn condensed_and_mixed_cups_agree() {
 
 /// See [`condensed_and_mixed_cups_agree`].
 const CONDENSED_BOUND: f64 = 1e-9;
+
+/// The script's default step follows the mesh: 0.5 mm of travel per increment on 25 x 25
+/// and coarser meshes (3 mm cells and up), a sixth of the in-plane cell on finer ones
+/// (docs/convergence.md, "Time step and mesh"). 30 x 30 cells are 2.5 mm, so 0.5 mm of
+/// travel takes two increments of 0.25 mm; 8 x 8 cells keep 0.5 mm.
+#[test]
+fn the_default_step_follows_the_cell() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (cells, travel, expected) in [(30, 0.5, [0.25, 0.25]), (8, 1.0, [0.5, 0.5])] {
+        let out = out_dir(&format!("step_{cells}"));
+        let status = Command::new(env!("CARGO_BIN_EXE_tribo"))
+            .current_dir(root)
+            .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
+            .arg(&out)
+            .args(["--set", "charts=false", "--set"])
+            .arg(format!("cells={cells}"))
+            .arg("--set")
+            .arg(format!("travel={travel:?}"))
+            .status()
+            .expect("tribo runs");
+        assert!(status.success(), "square cup ({cells} cells) failed");
+        let text = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+        let dt = header.iter().position(|h| *h == "dt [mm]").expect("dt");
+        let steps: Vec<f64> = lines
+            .map(|l| l.split(',').nth(dt).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(steps, expected, "{cells} cells");
+        // Nominal increments, not the halves of a cut-back one.
+        let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+        let summary: Value = serde_json::from_str(&text).expect("summary.json is JSON");
+        assert_eq!(number(&summary, "cutbacks"), 0.0, "{cells} cells");
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
