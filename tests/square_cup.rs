@@ -166,25 +166,38 @@ fn defaults_converge_in_few_iterations_and_keep_the_answer() {
 /// Per increment: Newton iterations, and the tools' forces (x, y, z of punch, blankholder,
 /// die) from history.csv.
 fn history(out: &Path) -> Vec<(usize, Vec<f64>)> {
+    let names: Vec<String> = std::iter::once("newton_iterations".to_string())
+        .chain(
+            ["punch", "blankholder", "die"]
+                .iter()
+                .flat_map(|t| ["x", "y", "z"].map(|c| format!("{t}_force_{c}"))),
+        )
+        .collect();
+    history_columns(out, &names)
+        .into_iter()
+        .map(|row| (row[0] as usize, row[1..].to_vec()))
+        .collect()
+}
+
+/// Per increment, the values of the named columns of history.csv, in the order named.
+fn history_columns(out: &Path, names: &[impl AsRef<str>]) -> Vec<Vec<f64>> {
     let text = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("header").split(',').collect();
     // Column names carry their unit after a space: "punch_force_x [N]".
-    let column = |name: &str| {
-        (header.iter())
-            .position(|h| h.split(" [").next() == Some(name))
-            .expect(name)
-    };
-    let iterations = column("newton_iterations");
-    let forces: Vec<usize> = ["punch", "blankholder", "die"]
+    let columns: Vec<usize> = names
         .iter()
-        .flat_map(|t| ["x", "y", "z"].map(|c| column(&format!("{t}_force_{c}"))))
+        .map(|name| {
+            let name = name.as_ref();
+            (header.iter())
+                .position(|h| h.split(" [").next() == Some(name))
+                .expect(name)
+        })
         .collect();
     lines
         .map(|line| {
             let v: Vec<&str> = line.split(',').collect();
-            let f = forces.iter().map(|&k| v[k].parse().unwrap()).collect();
-            (v[iterations].parse().unwrap(), f)
+            columns.iter().map(|&k| v[k].parse().unwrap()).collect()
         })
         .collect()
 }
@@ -338,31 +351,22 @@ const CONDENSED_BOUND: f64 = 1e-9;
 /// travel takes two increments of 0.25 mm; 8 x 8 cells keep 0.5 mm.
 #[test]
 fn the_default_step_follows_the_cell() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     for (cells, travel, expected) in [(30, 0.5, [0.25, 0.25]), (8, 1.0, [0.5, 0.5])] {
         let out = out_dir(&format!("step_{cells}"));
-        let status = Command::new(env!("CARGO_BIN_EXE_tribo"))
-            .current_dir(root)
-            .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
-            .arg(&out)
-            .args(["--set", "charts=false", "--set"])
-            .arg(format!("cells={cells}"))
-            .arg("--set")
-            .arg(format!("travel={travel:?}"))
-            .status()
-            .expect("tribo runs");
-        assert!(status.success(), "square cup ({cells} cells) failed");
-        let text = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
-        let mut lines = text.lines();
-        let header: Vec<&str> = lines.next().expect("header").split(',').collect();
-        let dt = header.iter().position(|h| *h == "dt [mm]").expect("dt");
-        let steps: Vec<f64> = lines
-            .map(|l| l.split(',').nth(dt).unwrap().parse().unwrap())
+        let summary = run_cup_with(
+            &out,
+            &[
+                "charts=false",
+                &format!("cells={cells}"),
+                &format!("travel={travel:?}"),
+            ],
+        );
+        let steps: Vec<f64> = history_columns(&out, &["dt"])
+            .into_iter()
+            .map(|row| row[0])
             .collect();
         assert_eq!(steps, expected, "{cells} cells");
         // Nominal increments, not the halves of a cut-back one.
-        let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
-        let summary: Value = serde_json::from_str(&text).expect("summary.json is JSON");
         assert_eq!(number(&summary, "cutbacks"), 0.0, "{cells} cells");
         let _ = std::fs::remove_dir_all(&out);
     }
