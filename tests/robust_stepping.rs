@@ -505,9 +505,10 @@ fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
     );
 }
 
-/// Fixed stepping: each history row counts the cutbacks made before it was reached, so the
-/// rows of a nominal increment add up to its number of halvings (a row's dt is the nominal
-/// one halved that many times so far) and history.csv's column sums to the failed attempts.
+/// Fixed stepping: each history row counts the cutbacks made before it was reached, since
+/// the last converged part, so a row's dt is the rest of its nominal increment halved that
+/// many times (the rest is tried whole after each converged part) and history.csv's column
+/// sums to the failed attempts.
 #[test]
 fn fixed_step_cutbacks_are_counted_once() {
     let script = robust_script("fast_drag.rhai");
@@ -527,18 +528,19 @@ fn fixed_step_cutbacks_are_counted_once() {
     let dt = history_column(&dir, "dt");
     let cutbacks = history_column(&dir, "cutbacks");
     // Two nominal increments of 1 (end time 2).
-    let (mut nominal_end, mut halvings) = (1.0, 0.0);
+    let (mut nominal_end, mut start) = (1.0, 0.0);
     for k in 0..time.len() {
-        halvings += cutbacks[k];
-        let expected = 1.0 / 2f64.powf(halvings);
+        let expected = (nominal_end - start) / 2f64.powf(cutbacks[k]);
         assert!(
             (dt[k] - expected).abs() <= 1e-12,
-            "row {k}: dt {} after {halvings} halvings, expected {expected}",
-            dt[k]
+            "row {k}: dt {} after {} halvings of the rest {}, expected {expected}",
+            dt[k],
+            cutbacks[k],
+            nominal_end - start
         );
+        start = time[k];
         if (time[k] - nominal_end).abs() <= 1e-12 {
             nominal_end += 1.0;
-            halvings = 0.0;
         }
     }
     let total: f64 = cutbacks.iter().sum();
