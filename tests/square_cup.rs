@@ -376,10 +376,10 @@ fn the_default_step_follows_the_cell() {
 /// 4 halvings) through its hardest spot, where the flange between die and holder barely
 /// touches either (the holder force falls to its minimum, about 0.8 kN, near 7.8 mm): a
 /// part of the increment ending there fails even at a sixteenth of the step, while the rest
-/// of the increment taken whole after a converged part gets over it. So fixed stepping
-/// tries the rest whole after each converged part (`Simulation::step_fixed`); with the
-/// parts kept at the halved size, as before, this run stopped at 7.78 mm. The parts are
-/// then not all halves of 0.5 mm: at least one increment is not 0.5 / 2^k.
+/// of the increment tried whole and halved afresh gets over it. So fixed stepping tries the
+/// rest whole where a part fails after a converged one (`Simulation::step_fixed`); with
+/// only halvings of the parts, as before, this run stopped at 7.78 mm. The parts are then
+/// not all halves of 0.5 mm: at least one increment is not 0.5 / 2^k.
 #[test]
 fn the_solid_shell_paper_cup_steps_over_its_flange_lift_off() {
     let out = out_dir("solid_shell_lift_off");
