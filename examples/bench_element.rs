@@ -14,21 +14,9 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-/// Seconds of processor time this thread has used, if the system reports it.
-fn thread_cpu_seconds() -> Option<f64> {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
-}
-
-/// A clock for one round: thread CPU time, else wall time since `wall`.
-fn clock(wall: &Instant) -> f64 {
-    thread_cpu_seconds().unwrap_or_else(|| wall.elapsed().as_secs_f64())
-}
+#[path = "bench_support/mod.rs"]
+mod bench_support;
+use bench_support::{clock, thread_cpu_seconds, Uniform};
 use tribo::element::{hex8_fbar_reference, Element, Hex8FBar};
 use tribo::geometry::Vec3;
 use tribo::material::{ElastoPlastic, Hardening, Hill48, LinearElastic, Material, PointState};
@@ -37,17 +25,9 @@ use tribo::mesh::HEX_CORNERS;
 const ROUNDS: usize = 9;
 
 fn main() {
-    let evaluations: usize = std::env::args()
-        .nth(1)
-        .map(|s| s.parse().expect("EVALUATIONS must be a number"))
-        .unwrap_or(20_000);
-    let mut seed = 7u64;
-    let mut next = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    };
+    let evaluations = bench_support::evaluations(20_000);
+    let mut uniform = Uniform::new(7);
+    let mut next = || uniform.next();
     let x: [Vec3; 8] = std::array::from_fn(|a| {
         let c = HEX_CORNERS[a];
         Vec3::new(c[0] + 1.0, c[1] + 1.0, c[2] + 1.0) * 0.5

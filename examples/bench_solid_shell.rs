@@ -12,36 +12,20 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use tribo::element::{solid_shell, Element, SolidShell};
+#[path = "bench_support/mod.rs"]
+mod bench_support;
+use bench_support::{clock, Uniform};
+use tribo::element::{solid_shell, Element, ElementKind, StrainTheory};
 use tribo::geometry::Vec3;
 use tribo::material::{ElastoPlastic, Hardening, Hill48, LinearElastic, Material, PointState};
 use tribo::mesh::HEX_CORNERS;
 
 const ROUNDS: usize = 9;
 
-/// Seconds of processor time this thread has used, if the system reports it.
-fn thread_cpu_seconds() -> Option<f64> {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
-}
-
 fn main() {
-    let evaluations: usize = std::env::args()
-        .nth(1)
-        .map(|s| s.parse().expect("EVALUATIONS must be a number"))
-        .unwrap_or(5_000);
-    let mut seed = 11u64;
-    let mut next = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    };
+    let evaluations = bench_support::evaluations(5_000);
+    let mut uniform = Uniform::new(11);
+    let mut next = || uniform.next();
     // A 2 x 2 x 0.2 cell, its corners moved by up to 5 % of the cell.
     let x: [Vec3; 8] = std::array::from_fn(|a| {
         let c = HEX_CORNERS[a];
@@ -57,18 +41,16 @@ fn main() {
         Hardening::swift(576.79, 0.01658, 0.3593).unwrap(),
     );
     let el: &dyn Element<24> = solid_shell::select(
-        tribo::element::ElementKind::SolidShell,
-        tribo::element::StrainTheory::Finite,
+        ElementKind::SolidShell,
+        StrainTheory::Finite,
         true,
         solid_shell::DEFAULT_THICKNESS_POINTS,
     )
     .unwrap();
-    let _: Option<&SolidShell> = None;
     let np = el.point_count();
     let cases: [(&str, &dyn Material, f64); 2] =
         [("elastic", &elastic, 2e-4), ("plastic", &plastic, 0.02)];
     let wall = Instant::now();
-    let clock = || thread_cpu_seconds().unwrap_or_else(|| wall.elapsed().as_secs_f64());
     println!(
         "solid-shell, {np} points, {evaluations} evaluations x {ROUNDS} rounds; fastest round, us per element"
     );
@@ -110,7 +92,7 @@ fn main() {
         let mut times = [Vec::new(), Vec::new(), Vec::new()];
         for _ in 0..ROUNDS {
             for (kernel, t) in times.iter_mut().enumerate() {
-                let start = clock();
+                let start = clock(&wall);
                 for _ in 0..evaluations {
                     let u = black_box(&u);
                     match kernel {
@@ -127,21 +109,6 @@ fn main() {
                             )
                             .unwrap()
                         }
-                        1 => {
-                            memory.copy_from_slice(&memory_then);
-                            el.evaluate_remembering(
-                                &x,
-                                u,
-                                &committed,
-                                &mut trial,
-                                material,
-                                &mut memory,
-                                &mut force,
-                                Some(&mut stiffness),
-                            )
-                            .map(|_| ())
-                            .unwrap()
-                        }
                         _ => {
                             memory.copy_from_slice(&memory_then);
                             el.evaluate_remembering(
@@ -152,7 +119,7 @@ fn main() {
                                 material,
                                 &mut memory,
                                 &mut force,
-                                None,
+                                (kernel == 1).then_some(&mut stiffness[..]),
                             )
                             .map(|_| ())
                             .unwrap()
@@ -160,7 +127,7 @@ fn main() {
                     }
                     black_box((&force, &stiffness));
                 }
-                t.push((clock() - start) / evaluations as f64 * 1e6);
+                t.push((clock(&wall) - start) / evaluations as f64 * 1e6);
             }
         }
         // The fastest round: interference from a shared machine only adds time.
