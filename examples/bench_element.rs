@@ -16,13 +16,11 @@ use std::time::Instant;
 
 #[path = "bench_support/mod.rs"]
 mod bench_support;
-use bench_support::{clock, thread_cpu_seconds, Uniform};
+use bench_support::{clock, thread_cpu_seconds, Uniform, ROUNDS};
 use tribo::element::{hex8_fbar_reference, Element, Hex8FBar};
 use tribo::geometry::Vec3;
 use tribo::material::{ElastoPlastic, Hardening, Hill48, LinearElastic, Material, PointState};
 use tribo::mesh::HEX_CORNERS;
-
-const ROUNDS: usize = 9;
 
 fn main() {
     let evaluations = bench_support::evaluations(20_000);

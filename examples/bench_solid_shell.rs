@@ -14,13 +14,11 @@ use std::time::Instant;
 
 #[path = "bench_support/mod.rs"]
 mod bench_support;
-use bench_support::{clock, Uniform};
+use bench_support::{clock, Uniform, ROUNDS};
 use tribo::element::{solid_shell, Element, ElementKind, StrainTheory};
 use tribo::geometry::Vec3;
 use tribo::material::{ElastoPlastic, Hardening, Hill48, LinearElastic, Material, PointState};
 use tribo::mesh::HEX_CORNERS;
-
-const ROUNDS: usize = 9;
 
 fn main() {
     let evaluations = bench_support::evaluations(5_000);
@@ -131,8 +129,8 @@ fn main() {
             }
         }
         // The fastest round: interference from a shared machine only adds time.
-        let median = |v: &mut Vec<f64>| v.iter().copied().fold(f64::INFINITY, f64::min);
-        let [first, predicted, residual] = times.map(|mut v| median(&mut v));
+        let [first, predicted, residual] =
+            times.map(|v| v.iter().copied().fold(f64::INFINITY, f64::min));
         println!("{name:<8} {first:>10.2} {predicted:>10.2} {residual:>10.2}");
     }
 }

@@ -2,6 +2,9 @@
 //! and reproducible pseudo-random numbers.
 use std::time::Instant;
 
+/// Timed rounds per kernel, interleaved so that drift of a shared machine hits all alike.
+pub const ROUNDS: usize = 9;
+
 /// Seconds of processor time this thread has used, if the system reports it.
 pub fn thread_cpu_seconds() -> Option<f64> {
     let mut ts = libc::timespec {
