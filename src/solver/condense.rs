@@ -566,13 +566,14 @@ impl Condenser {
             .as_ref()
             .filter(|l| l.jacobian.len() == j.values.len())
             .map(|l| self.dirty_segments(l, j, coefficients));
-        let mut a = SparseMatrix::zeros(self.pattern.clone());
-        if dirty.is_some() {
-            let kept = last
-                .as_ref()
-                .expect("dirty segments come from a last reduction");
-            a.values.copy_from_slice(&kept.values);
-        }
+        // Starting from the last reduction's values (copied, not zeroed and then copied).
+        let mut a = match (&dirty, last.as_ref()) {
+            (Some(_), Some(kept)) => SparseMatrix {
+                pattern: self.pattern.clone(),
+                values: kept.values.clone(),
+            },
+            _ => SparseMatrix::zeros(self.pattern.clone()),
+        };
         let mut rhs = vec![0.0; self.pattern.n];
         let mut replay = Replay {
             slots: &self.slots,
