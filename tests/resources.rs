@@ -243,7 +243,7 @@ fn output_size_is_capped() {
         o.stderr
     );
     let d = std::env::temp_dir().join(format!("tribo-res-{}-disk/out", std::process::id()));
-    let written: u64 = std::fs::read_dir(d)
+    let written: u64 = std::fs::read_dir(&d)
         .unwrap()
         .map(|e| e.unwrap().metadata().unwrap().len())
         .sum();
@@ -252,4 +252,6 @@ fn output_size_is_capped() {
         written <= (8 << 20) + (512 << 10),
         "{written} bytes written"
     );
+    // The 8 MB written are not left in the system's temp folder.
+    let _ = std::fs::remove_dir_all(d.parent().expect("the run's folder"));
 }

@@ -13,14 +13,23 @@ use tribo::script::{self, HostOptions};
 /// than 20 s.
 const OWN_TEST: &[&str] = &["u_channel"];
 
-/// Runs one scene script; its error (script, line, column and message) on failure.
+/// Runs one scene script; its error (script, line, column and message) on failure. The
+/// output (frames of every increment, several MB per scene) is removed when the scene
+/// passes and kept, with its folder named, when it fails.
 fn run_scene(path: &std::path::Path) -> Result<(), String> {
     let name = path.file_stem().unwrap().to_string_lossy().to_string();
+    let out = std::env::temp_dir().join(format!("tribo-scene-{}-{name}", std::process::id()));
     let host = HostOptions {
-        out_dir: std::env::temp_dir().join(format!("tribo-scene-{}-{name}", std::process::id())),
+        out_dir: out.clone(),
         ..HostOptions::default()
     };
-    script::run_file(path, &[], &host).map_err(|e| format!("{name}: {e}"))
+    match script::run_file(path, &[], &host) {
+        Ok(_) => {
+            let _ = std::fs::remove_dir_all(&out);
+            Ok(())
+        }
+        Err(e) => Err(format!("{name}: {e} (output in {})", out.display())),
+    }
 }
 
 #[test]
