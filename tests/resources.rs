@@ -15,8 +15,14 @@ struct Outcome {
     wall: Duration,
 }
 
+/// The folder of the run tagged `tag` (script, stderr, and the run's `out`).
+fn run_dir(tag: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("tribo-res-{}-{tag}", std::process::id()))
+}
+
+/// [`run_dir`], emptied.
 fn dir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tribo-res-{}-{tag}", std::process::id()));
+    let d = run_dir(tag);
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -181,7 +187,7 @@ fn increments_and_paths_are_bounded() {
         o.stderr
     );
     assert!(o.wall < Duration::from_secs(60), "{:?}", o.wall);
-    let out = std::env::temp_dir().join(format!("tribo-res-{}-1e308/out", std::process::id()));
+    let out = run_dir("1e308").join("out");
     assert!(
         folder_bytes(&out) < 1 << 20,
         "{} bytes written",
@@ -242,8 +248,7 @@ fn output_size_is_capped() {
         "{}",
         o.stderr
     );
-    let d = std::env::temp_dir().join(format!("tribo-res-{}-disk/out", std::process::id()));
-    let written: u64 = std::fs::read_dir(&d)
+    let written: u64 = std::fs::read_dir(run_dir("disk").join("out"))
         .unwrap()
         .map(|e| e.unwrap().metadata().unwrap().len())
         .sum();
@@ -253,5 +258,5 @@ fn output_size_is_capped() {
         "{written} bytes written"
     );
     // The 8 MB written are not left in the system's temp folder.
-    let _ = std::fs::remove_dir_all(d.parent().expect("the run's folder"));
+    let _ = std::fs::remove_dir_all(run_dir("disk"));
 }
