@@ -467,6 +467,7 @@ impl RunOutput {
             "increments": sim.history.len(),
             "newton_iterations": iterations,
             "cutbacks": sim.history.iter().map(|r| r.cutbacks).sum::<usize>(),
+            "last_resort_increments": sim.history.iter().filter(|r| r.last_resort.is_some()).count(),
             "cutback_reasons": sim.history.iter().flat_map(|r| {
                 r.cutback_reasons.iter().map(move |why| serde_json::json!({
                     "increment": r.index,

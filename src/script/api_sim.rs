@@ -519,6 +519,10 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
         "cutback_reasons".into(),
         Dynamic::from(strings(r.cutback_reasons.iter().map(String::as_str))),
     );
+    m.insert(
+        "last_resort".into(),
+        r.last_resort.clone().map_or(Dynamic::UNIT, Dynamic::from),
+    );
     m.insert("dt".into(), Dynamic::from(r.dt));
     m.insert("rejected_steps".into(), Dynamic::from(r.rejected as i64));
     m.insert(
@@ -746,6 +750,7 @@ pub const SETTING_KEYS: &[&str] = &[
     "anti_cycling",
     "cycle_flips",
     "rollback_depth",
+    "last_resort",
 ];
 
 fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptResult<()> {
@@ -786,6 +791,7 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             "cycle_flips" => step.cycle_flips = count(key)?,
             "status_prediction" => s.status_prediction = count(key)?,
             "rollback_depth" => step.rollback_depth = count(key)?,
+            "last_resort" => step.last_resort = flag(v, key)?,
             "checkpoint_every" => st.checkpoint_every = count(key)?,
             "increments" => {
                 let n = number(v, key)?;

@@ -6,6 +6,7 @@ use super::assembly::{Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
 use super::cycling::{CyclingMonitor, CyclingNode};
 use super::force_control;
 use super::linear::LinearSolver;
+use super::pseudo_transient::PseudoTransient;
 use super::simulation::Simulation;
 use crate::contact::{ContactStatus, FrameUpdate};
 use crate::{Error, Result};
@@ -50,6 +51,38 @@ pub struct IterationRecord {
 
 fn full_step_default() -> bool {
     true
+}
+
+/// Which attempt at an increment a Newton iteration is (module `stepping`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Attempt {
+    /// Newton as configured: status prediction, the settings' budget, the divergence guard.
+    Regular,
+    /// The first last resort at the smallest part: plain Newton (no status prediction), a
+    /// longer budget, no divergence guard.
+    LongPlain,
+    /// The second: pseudo-transient continuation.
+    Continuation,
+}
+
+impl Attempt {
+    /// The attempt to make where this one failed at the smallest part.
+    pub(super) fn next(self) -> Option<Attempt> {
+        match self {
+            Attempt::Regular => Some(Attempt::LongPlain),
+            Attempt::LongPlain => Some(Attempt::Continuation),
+            Attempt::Continuation => None,
+        }
+    }
+
+    /// How reports and messages name it.
+    pub(super) fn name(self) -> &'static str {
+        match self {
+            Attempt::Regular => "Newton",
+            Attempt::LongPlain => "plain Newton with a longer budget",
+            Attempt::Continuation => "pseudo-transient continuation",
+        }
+    }
 }
 
 /// A converged Newton solve of one increment, not yet committed.
@@ -241,15 +274,19 @@ impl Simulation {
 
     /// Newton's method for the increment to `t_new`, with `prediction` status-prediction
     /// rounds per step (`Settings::status_prediction`, or 0 for the plain step) and at most
-    /// `max_iterations` iterations.
+    /// `max_iterations` iterations. A last-resort `attempt` runs without the divergence
+    /// guard; [`Attempt::Continuation`] solves each step from a shifted Jacobian
+    /// ([`PseudoTransient`]).
     pub(super) fn newton(
         &self,
         t_new: f64,
         linear: &mut dyn LinearSolver,
         prediction: usize,
         max_iterations: usize,
+        attempt: Attempt,
         times: &mut PhaseTimes,
     ) -> Result<Trial> {
+        let mut continuation = (attempt == Attempt::Continuation).then(PseudoTransient::new);
         let mut settings = self.model.settings.clone();
         settings.status_prediction = prediction;
         settings.max_iterations = max_iterations;
@@ -401,7 +438,8 @@ impl Simulation {
                 .find(|&v| v > settings.force_rel_tol)
                 .unwrap_or(f64::INFINITY);
             let first_merit = merits.iter().copied().find(|&v| v > 0.0).unwrap_or(0.0);
-            let grew = !force_controlled
+            let grew = attempt == Attempt::Regular
+                && !force_controlled
                 && merits.len() > window_start + DIVERGENCE_ITERATIONS
                 && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
                     .windows(2)
@@ -418,9 +456,13 @@ impl Simulation {
                 )));
             }
             let ts = Instant::now();
-            let dx = match next_step.take() {
-                Some(dx) => dx,
-                None => self.newton_step(&eval, linear)?,
+            let dx = match (next_step.take(), continuation.as_mut()) {
+                (Some(dx), _) => dx,
+                (None, Some(ptc)) => {
+                    let sigma = ptc.shift(merit);
+                    PseudoTransient::step(self, &mut eval, n_u, sigma, linear)?
+                }
+                (None, None) => self.newton_step(&eval, linear)?,
             };
             // Frozen statuses (anti-cycling) are a problem of their own: not re-linearised.
             let dx = if settings.status_prediction > 0 && ctx.forced.is_none() {

@@ -13,7 +13,7 @@ use super::linear::{LinearSolver, Solver};
 use super::model::Model;
 use super::newton::{IterationRecord, Trial};
 use super::sparse::SparsePattern;
-use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController, StepMode};
+use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController};
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
 use crate::geometry::Vec3;
 use crate::material::PointState;
@@ -58,31 +58,10 @@ pub struct IncrementReport {
     /// error"), one per cutback counted in `cutbacks`.
     #[serde(default)]
     pub cutback_reasons: Vec<String>,
-}
-
-/// Failures after which a smaller increment may succeed.
-/// Newton iterations of the plain retry of an increment that failed with status
-/// prediction (the plain retries that converged on the 25 x 25 x 1 paper cup took at most
-/// 15).
-const PLAIN_RETRY_ITERATIONS: usize = 20;
-
-fn retryable(err: &Error) -> bool {
-    matches!(err, Error::NoConvergence(_) | Error::LinearSolver(_))
-}
-
-/// One line on a failed attempt: where it was tried and why it failed.
-fn cutback_reason(t_new: f64, dt: f64, err: &Error) -> String {
-    format!("t = {t_new} (dt = {dt}): {}", bare(err))
-}
-
-/// An error's message without its kind prefix, for nesting in another message.
-fn bare(err: &Error) -> String {
-    match err {
-        Error::NoConvergence(m) | Error::LinearSolver(m) | Error::Input(m) | Error::Script(m) => {
-            m.clone()
-        }
-        other => other.to_string(),
-    }
+    /// The last resort that got this increment through after Newton failed at the
+    /// smallest part the cut-backs allow (module `stepping`); `None` for Newton's own.
+    #[serde(default)]
+    pub last_resort: Option<String>,
 }
 
 /// Model plus its evolving, committed solution.
@@ -349,25 +328,6 @@ impl Simulation {
         self.context(time, None).evaluate(x, &mut t)
     }
 
-    /// Advances one increment. Fixed stepping: one nominal increment, halved on failure up
-    /// to `max_cutbacks` times (the sub-increments are all in `history`, each counting the
-    /// cutbacks made before it was reached, so that their sum is the run's number of failed
-    /// attempts; the returned report counts the whole nominal increment's). Adaptive
-    /// stepping: one increment of the size the controller chose (see `step_control`).
-    pub fn step(&mut self) -> Result<IncrementReport> {
-        self.check_interrupt()?;
-        if self.is_finished() {
-            return Err(Error::Input(format!(
-                "the simulation already reached its end time {}",
-                self.model.settings.end_time
-            )));
-        }
-        match self.model.settings.stepping.mode {
-            StepMode::Fixed => self.step_fixed(),
-            StepMode::Adaptive => self.step_adaptive(),
-        }
-    }
-
     /// Connects a stop request: a raised flag abandons the increment under way at its next
     /// Newton iteration (`Error::Interrupted`); the committed state stays the last
     /// converged one.
@@ -386,173 +346,8 @@ impl Simulation {
         Ok(())
     }
 
-    /// One nominal increment of fixed stepping, in parts where Newton fails: a failed
-    /// attempt is halved (at most `max_cutbacks` times in a row, never below `dt_min`), a
-    /// converged part is followed by one of its size, and where such a part fails the rest
-    /// of the nominal increment is tried whole before any further halving.
-    ///
-    /// Why the rest whole: a hard spot can be a single instant, where a barely touching
-    /// flange lifts off a tool, and a part ending just there fails where a longer one over
-    /// it converges. The solid-shell paper cup (25 x 25 x 1) met one at 7.8 mm: its parts
-    /// of a sixteenth of the step ran into it and it got through only after seven
-    /// halvings; with the rest tried whole and halved afresh it gets over it under the
-    /// engine's budget (test `the_solid_shell_paper_cup_steps_over_its_flange_lift_off`).
-    /// Trying the rest whole after every converged part (not only after a failed one)
-    /// also did, but changed the U-channel's increments enough to take one to 30
-    /// iterations. Every converged part is at least `dt_min`, so an increment ends.
-    fn step_fixed(&mut self) -> Result<IncrementReport> {
-        let target = (self.time + self.nominal_dt()).min(self.model.settings.end_time);
-        let dt_min = self
-            .model
-            .settings
-            .stepping
-            .dt_min(self.model.settings.end_time);
-        let mut dt = target - self.time;
-        let (mut cutbacks, mut in_a_row, mut recorded) = (0, 0, 0);
-        let start = self.time;
-        let mut rest_tried = false;
-        let mut reasons = Vec::new();
-        loop {
-            let t_new = if dt >= target - self.time {
-                target
-            } else {
-                self.time + dt
-            };
-            match self.try_increment(t_new) {
-                Ok(trial) => {
-                    let mut report = self.accept(t_new, trial);
-                    report.cutbacks = cutbacks - recorded;
-                    report.cutback_reasons = reasons[recorded..].to_vec();
-                    recorded = cutbacks;
-                    self.history.push(report.clone());
-                    if t_new < target {
-                        // The next part keeps this one's size; the rest is tried whole only
-                        // where such a part fails (below).
-                        in_a_row = 0;
-                        rest_tried = false;
-                        continue;
-                    }
-                    report.cutbacks = cutbacks;
-                    report.cutback_reasons = reasons;
-                    return Ok(report);
-                }
-                Err(err @ Error::Interrupted(_)) => return Err(err),
-                Err(err)
-                    if retryable(&err) && !rest_tried && self.time > start && t_new < target =>
-                {
-                    reasons.push(cutback_reason(t_new, t_new - self.time, &err));
-                    cutbacks += 1;
-                    rest_tried = true;
-                    dt = target - self.time;
-                }
-                Err(err)
-                    if retryable(&err)
-                        && in_a_row < self.model.settings.max_cutbacks
-                        && 0.5 * dt >= dt_min =>
-                {
-                    reasons.push(cutback_reason(t_new, t_new - self.time, &err));
-                    cutbacks += 1;
-                    in_a_row += 1;
-                    dt *= 0.5;
-                }
-                Err(err) => {
-                    return Err(Error::NoConvergence(format!(
-                        "increment {} from t = {} with dt = {dt} after {cutbacks} cutbacks: {}",
-                        self.increments_done + 1,
-                        self.time,
-                        bare(&err)
-                    )))
-                }
-            }
-        }
-    }
-
-    fn step_adaptive(&mut self) -> Result<IncrementReport> {
-        let step = self.model.settings.stepping.clone();
-        let end = self.model.settings.end_time;
-        let dt_min = step.dt_min(end);
-        let mut dt = self.controller.dt.max(dt_min);
-        let (mut cutbacks, mut rejected) = (0, 0);
-        let mut reasons = Vec::new();
-        loop {
-            let t_new = StepController::next_time(self.time, dt, &self.stops);
-            let dt_used = t_new - self.time;
-            match self.try_increment(t_new) {
-                Ok(trial) => {
-                    let measures = self.measures(&trial);
-                    let verdict = self
-                        .controller
-                        .assess(&step, end, dt_used, &measures, trial.iterations);
-                    if !verdict.accept {
-                        self.phase_times.add(&trial.times);
-                        rejected += 1;
-                        dt = verdict.next_dt;
-                        continue;
-                    }
-                    let mut report = self.accept(t_new, trial);
-                    report.cutbacks = cutbacks;
-                    report.cutback_reasons = std::mem::take(&mut reasons);
-                    report.rejected = rejected;
-                    report.measures = measures;
-                    report.limit = verdict.limit;
-                    let (ratio, which) = measures.ratio(&step);
-                    if ratio < 1.0 {
-                        report.warnings.push(super::step_control::limit_warning(
-                            which,
-                            1.0 / ratio,
-                            dt_min,
-                            !std::mem::replace(&mut self.limit_explained, true),
-                        ));
-                    }
-                    // No growth right after a cutback.
-                    let next = if cutbacks > 0 {
-                        verdict.next_dt.min(dt_used.max(dt_min))
-                    } else {
-                        verdict.next_dt
-                    };
-                    self.controller = StepController {
-                        dt: next,
-                        limit: verdict.limit,
-                    };
-                    report.next_dt = next;
-                    self.history.push(report.clone());
-                    return Ok(report);
-                }
-                Err(err @ Error::Interrupted(_)) => return Err(err),
-                Err(err) if retryable(&err) && dt_used > dt_min * (1.0 + 1e-9) => {
-                    reasons.push(cutback_reason(t_new, dt_used, &err));
-                    cutbacks += 1;
-                    dt = (0.5 * dt_used).max(dt_min);
-                    self.controller.limit = Limit::Divergence;
-                }
-                Err(err) => {
-                    return Err(Error::NoConvergence(format!(
-                        "increment {} from t = {} cannot be completed at the minimum step dt = {dt_used:.6e} (dt_min = {dt_min:.6e}) after {cutbacks} cutbacks: {}",
-                        self.increments_done + 1,
-                        self.time,
-                        bare(&err)
-                    )))
-                }
-            }
-        }
-    }
-
-    /// Largest plastic strain, rotation and slip increments of a converged trial.
-    fn measures(&self, trial: &Trial) -> IncrementMeasures {
-        let mut m = IncrementMeasures::from_points(&self.points, &trial.eval.trial_points);
-        for (c, contact) in self.model.contacts.iter().enumerate() {
-            for (k, &node) in contact.candidates.iter().enumerate() {
-                let (res, _) = &trial.eval.nodal[c][k];
-                if res.status.is_active() {
-                    m.add_slip(node, res.slip_increment.norm());
-                }
-            }
-        }
-        m
-    }
-
     /// Commits a converged trial (keeping the state it replaces for `rollback`).
-    fn accept(&mut self, t_new: f64, trial: Trial) -> IncrementReport {
+    pub(super) fn accept(&mut self, t_new: f64, trial: Trial) -> IncrementReport {
         let depth = self.model.settings.stepping.rollback_depth;
         if depth > 0 {
             if self.saved.len() >= depth {
@@ -624,40 +419,6 @@ impl Simulation {
             on_increment(self, &report)?;
         }
         Ok(())
-    }
-
-    /// Newton's method for the increment ending at `t_new`, nothing committed.
-    fn try_increment(&mut self, t_new: f64) -> Result<Trial> {
-        // The factorization cache lives outside `self` while the context borrows it.
-        let mut linear = std::mem::take(&mut self.linear);
-        linear.set_threads(super::assembly::worker_threads(self.model.settings.threads));
-        let prediction = self.model.settings.status_prediction;
-        let budget = self.model.settings.max_iterations;
-        // Every attempt's time is the run's: a failed one's is counted here, an accepted
-        // one's (with a failed predicted attempt before its plain retry) when committed.
-        let mut spent = PhaseTimes::default();
-        let mut outcome = self.newton(t_new, &mut linear, prediction, budget, &mut spent);
-        // A re-solved step can lead far off where many nodes change status at once (no
-        // merit check guards it, see `status_prediction`), and the increment then fails
-        // where the plain Newton would not: it is tried once more, plainly, before any
-        // cutback (25 x 25 x 1 paper cup to 30 mm: 9 cutbacks and 56 s without the retry,
-        // none and 45 s with it; BENCHMARKS.md). With a short budget: where the plain
-        // Newton cannot converge either (it cycles on the solid-shell cup), a retry with
-        // the whole budget cost more than the cutback it was meant to avoid.
-        if prediction > 0 && matches!(&outcome, Err(e) if retryable(e)) {
-            outcome = self.newton(
-                t_new,
-                &mut linear,
-                0,
-                budget.min(PLAIN_RETRY_ITERATIONS),
-                &mut spent,
-            );
-        }
-        if outcome.is_err() {
-            self.phase_times.add(&spent);
-        }
-        self.linear = linear;
-        outcome
     }
 
     fn commit(
@@ -770,6 +531,7 @@ impl Simulation {
             cycling: Vec::new(),
             warnings: Vec::new(),
             cutback_reasons: Vec::new(),
+            last_resort: None,
         }
     }
 

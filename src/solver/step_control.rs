@@ -79,6 +79,9 @@ pub struct StepSettings {
     pub cycle_flips: usize,
     /// How many committed states are kept for `rollback`.
     pub rollback_depth: usize,
+    /// Where Newton fails at the smallest part, the last resorts before the run stops
+    /// (module `stepping`).
+    pub last_resort: bool,
 }
 
 impl Default for StepSettings {
@@ -97,6 +100,7 @@ impl Default for StepSettings {
             anti_cycling: AntiCycling::Off,
             cycle_flips: 3,
             rollback_depth: 3,
+            last_resort: true,
         }
     }
 }
