@@ -16,6 +16,10 @@
 //! 2. [`Attempt::Continuation`]: pseudo-transient continuation (`pseudo_transient`),
 //!    which damps the soft modes a full Newton step throws across a near-mechanism.
 //!
+//! Under fixed stepping, where both fail on the smallest part, both are tried on the rest of
+//! the increment whole (a hard instant can be easier to step over than to stop just past,
+//! as for the regular attempts in `step_fixed`).
+//!
 //! Both solve the same equations to the same tolerances; an increment that needed one says
 //! so in its report (`last_resort`, a warning). Every run whose increments converge
 //! without them keeps its increments bit for bit: they start only where the run would
@@ -130,6 +134,8 @@ impl Simulation {
         // part failed (the last resorts; empty for a regular attempt).
         let mut attempt = Attempt::Regular;
         let mut failures: Vec<String> = Vec::new();
+        // Whether the last resorts have gone on to the rest of the increment whole.
+        let mut resorts_on_rest = false;
         loop {
             let t_new = if dt >= target - self.time {
                 target
@@ -149,6 +155,7 @@ impl Simulation {
                         ));
                         attempt = Attempt::Regular;
                         failures.clear();
+                        resorts_on_rest = false;
                     }
                     report.cutbacks = cutbacks - recorded;
                     report.cutback_reasons = reasons[recorded..].to_vec();
@@ -195,6 +202,16 @@ impl Simulation {
                         Some(next) => {
                             failures.push(attempt_failure(attempt, t_new, dt_part, &err));
                             attempt = next;
+                        }
+                        // Both failed on the smallest part: the last resorts on the rest
+                        // of the increment whole, as the regular attempts do above.
+                        None if retryable(&err) && !resorts_on_rest && t_new < target => {
+                            failures.push(attempt_failure(attempt, t_new, dt_part, &err));
+                            attempt = Attempt::Regular
+                                .next()
+                                .expect("a regular attempt has a last resort");
+                            resorts_on_rest = true;
+                            dt = target - self.time;
                         }
                         None => {
                             return Err(Error::NoConvergence(format!(
