@@ -27,7 +27,7 @@ sim.add_tool(tool("floor", plane([0, 0, 0], [0, 0, 1])).friction(|work, slip, pr
 sim.load("z+", [0.0, 0.0, -100.0], [[0.0, 0.0], [1.0, 1.0]]);
 sim.prescribe("z+", "x", [[0.0, 0.0], [1.0, 0.0], [2.0, 0.5]]);
 sim.fix("z+", "y");
-sim.settings(#{{ end_time: 2.0, increments: 4, max_cutbacks: 0, force_tolerance: 1e-12, contact_tolerance: 1e-12 }});
+sim.settings(#{{ end_time: 2.0, increments: 4, max_cutbacks: 0, force_tolerance: 1e-12, contact_tolerance: 1e-12, last_resort: false }});
 {run}
 "#
     )
@@ -128,6 +128,31 @@ fn a_non_converging_increment_stops_with_summary_and_final_checkpoint() {
         "{}",
         s.error
     );
+    assert_final_state(&s, 2);
+}
+
+/// Where the last resorts fail too (tolerances below round-off: nothing converges), the
+/// run stops after them, and its reason names every attempt at the smallest part.
+#[test]
+fn a_stop_after_the_last_resorts_names_every_attempt() {
+    let s = run_until_stop(
+        "last_resorts",
+        &scene(
+            "0.25",
+            "sim.step(); sim.step(); sim.settings(#{ last_resort: true, force_tolerance: 1e-30, force_abs_tolerance: 1e-300, contact_tolerance: 1e-300 }); sim.step();",
+        ),
+        |_| {},
+    );
+    assert_eq!(s.summary["status"], "stopped");
+    let reason = s.summary["error"].as_str().unwrap();
+    assert!(reason.contains("increment 3"), "{reason}");
+    for attempt in [
+        "Newton: t = ",
+        "plain Newton with a longer budget: t = ",
+        "pseudo-transient continuation: 80 Newton iterations without convergence",
+    ] {
+        assert!(reason.contains(attempt), "{attempt} in {reason}");
+    }
     assert_final_state(&s, 2);
 }
 

@@ -258,6 +258,8 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
         "cells=24",
         "max_iterations=10",
         "max_cutbacks=0",
+        // The stop is what this test is about: no last resorts at the smallest step.
+        "last_resort=false",
     ];
     let sets = |mode: &str| {
         let mut v: Vec<_> = common_sets
@@ -340,6 +342,8 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
             script::parse_override(&format!("anti_cycling={mode}")).unwrap(),
             script::parse_override(&format!("line_search={line_search}")).unwrap(),
             script::parse_override(&format!("status_prediction={rounds}")).unwrap(),
+            // Newton's own behaviour is compared: no last resorts before a stop.
+            script::parse_override("last_resort=false").unwrap(),
         ];
         (script::run_file(&script, &sets, &host), dir)
     };
@@ -487,6 +491,7 @@ fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
     model.settings.max_iterations = 1;
     model.settings.status_prediction = 0;
     model.settings.stepping.dt_min = Some(0.4);
+    model.settings.stepping.last_resort = false;
     let mut sim = Simulation::new(model).unwrap();
     let err = sim.step().unwrap_err().to_string();
     println!("{err}");
