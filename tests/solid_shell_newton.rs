@@ -5,6 +5,10 @@
 //! (the tight local solve, from the converged parameters, against the same committed
 //! states): its stresses and force equal the converged ones to round-off, so the converged
 //! state is the exact discrete problem's, not the early stop's.
+//!
+//! What the elements remember at a converged state starts the next increment's local
+//! solves, and a checkpoint keeps it: a restarted run repeats the uninterrupted one bit
+//! for bit.
 
 mod common;
 
@@ -16,8 +20,9 @@ use tribo::mesh::Mesh;
 use tribo::solver::{Model, Simulation};
 use tribo::tool::ScalarSchedule;
 
-#[test]
-fn converged_states_are_those_of_the_tight_local_solve() {
+/// A plastic solid-shell sheet (20 x 8 x 1) pressed and dragged by a roller in 8
+/// increments.
+fn roller_model() -> Model {
     let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 4.0, 1.0), [20, 8, 1]).unwrap();
     let material = ElastoPlastic::new(
         LinearElastic::new(70e3, 0.33).unwrap(),
@@ -40,7 +45,12 @@ fn converged_states_are_those_of_the_tight_local_solve() {
     model.settings.element = ElementKind::SolidShell;
     model.settings.end_time = 2.0;
     model.settings.increments = 8;
-    let mut sim = Simulation::new(model).unwrap();
+    model
+}
+
+#[test]
+fn converged_states_are_those_of_the_tight_local_solve() {
+    let mut sim = Simulation::new(roller_model()).unwrap();
     let element = sim.model.element().unwrap();
     let per = element.point_count();
     let (mut worst, mut checked): (f64, usize) = (0.0, 0);
@@ -101,4 +111,58 @@ fn converged_states_are_those_of_the_tight_local_solve() {
     // Round-off: the measured early-stopped iterates' stresses are off by 5e-11 to 1e-10
     // (tests/solid_shell_element.rs), 1e-12 tells them apart.
     assert!(worst < 1e-12, "{worst:e}");
+}
+
+/// The committed element memory is part of the checkpoint: a run restarted from one after 3
+/// increments ends bit for bit where the uninterrupted run does. Restarted without it (the
+/// field removed, as in a checkpoint of an older version), the next increment's first
+/// local solves start cold: the same converged answer to the Newton tolerance, other bits,
+/// which shows the memory is what the checkpoint restores.
+#[test]
+fn a_restart_repeats_the_run_with_the_elements_memory() {
+    use tribo::solver::checkpoint::Checkpoint;
+    let finish = |mut sim: Simulation| -> Vec<f64> {
+        while !sim.is_finished() {
+            sim.step().unwrap();
+        }
+        sim.displacements().to_vec()
+    };
+    let uninterrupted = finish(Simulation::new(roller_model()).unwrap());
+    let mut first = Simulation::new(roller_model()).unwrap();
+    for _ in 0..3 {
+        first.step().unwrap();
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&Checkpoint::of(&first, vec![0.0]).to_json().unwrap()).unwrap();
+    let memory = json["state"]["element_memory"].as_array().unwrap();
+    let remembered = first.model.element().unwrap().memory_len() * first.model.mesh.hexes.len();
+    assert_eq!(memory.len(), remembered);
+    assert!(
+        memory.iter().all(|v| v.is_f64()),
+        "every element remembers a linearisation"
+    );
+    let restarted = |json: &serde_json::Value| -> Vec<f64> {
+        let mut sim = Simulation::new(roller_model()).unwrap();
+        Checkpoint::from_json(&json.to_string(), "restart.json")
+            .unwrap()
+            .restore(&mut sim)
+            .unwrap();
+        finish(sim)
+    };
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&restarted(&json)), bits(&uninterrupted));
+    let mut cold = json.clone();
+    cold["state"]
+        .as_object_mut()
+        .unwrap()
+        .remove("element_memory");
+    let cold = restarted(&cold);
+    assert_ne!(bits(&cold), bits(&uninterrupted));
+    let scale = uninterrupted.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let off = cold
+        .iter()
+        .zip(&uninterrupted)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    // Two Newton paths converged to the same 1e-9 relative force residual.
+    assert!(off < 1e-6 * scale, "{off:e} of {scale:e}");
 }

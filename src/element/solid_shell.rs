@@ -84,6 +84,8 @@
 //! from the remembered `α` (without a memory: the values `trial` carries, else the committed
 //! ones) with full steps and, where those fail too (a 2-cycle across the elastic-plastic
 //! switch of some points, or an overshoot into material inversion), with halved steps.
+//! The solver keeps the memory of a converged increment with its committed state, so the
+//! next increment's first evaluation is predicted too.
 //!
 //! From a prediction the iteration stops earlier, at a step of
 //! [`PREDICTED_LOCAL_TOLERANCE`] (10⁻⁴) of the strain scale: the force is then within about

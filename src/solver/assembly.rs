@@ -144,9 +144,25 @@ struct ElementBuffers {
 
 /// What the elements remember between the evaluations of one Newton attempt
 /// ([`crate::element::Element::evaluate_remembering`]): `memory_len` numbers per element,
-/// NaN until an element writes them. A new attempt (a cut-back too) starts with none.
+/// NaN until an element writes them. An attempt starts from what the last converged
+/// increment left ([`ElementMemory::from`] the committed memory): the linearisation at the
+/// committed state predicts the first iterate's local solves, which otherwise start cold
+/// (several local iterations to the tight tolerance at every point).
 #[derive(Debug, Default)]
 pub struct ElementMemory(std::sync::Mutex<Vec<f64>>);
+
+impl From<Vec<f64>> for ElementMemory {
+    fn from(memory: Vec<f64>) -> Self {
+        Self(std::sync::Mutex::new(memory))
+    }
+}
+
+impl ElementMemory {
+    /// The numbers the elements left.
+    pub fn into_inner(self) -> Vec<f64> {
+        self.0.into_inner().unwrap_or_else(|e| e.into_inner())
+    }
+}
 
 /// Evaluates every element at the unknowns `x`, on `threads` threads over contiguous
 /// blocks of elements, writing the trial states of their integration points and each

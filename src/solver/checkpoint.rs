@@ -5,8 +5,9 @@
 //! and multipliers), every integration point's history, every contact pair's history
 //! (multiplier, slip reference point, projection hint, status, frictional work, slip, theta,
 //! flips, mu), the time, the increment counter, the step controller (next increment size),
-//! the energy balance and the forces of the trapezoidal energy rule, and the increment
-//! reports so far. The model itself (mesh, materials, tools, schedules, settings) is not
+//! the energy balance and the forces of the trapezoidal energy rule, what the elements
+//! remember of their last linearisation (where the solid-shell's next local solves start),
+//! and the increment reports so far. The model itself (mesh, materials, tools, schedules, settings) is not
 //! stored: the script builds it again, and [`Checkpoint::restore`] checks that it matches
 //! (sizes, tool names and candidates, tool positions at the checkpoint's time).
 //!
@@ -43,6 +44,28 @@ pub struct SavedState {
     /// The last increment's (dt, change of the displacements), for the extrapolating predictor.
     #[serde(default)]
     pub last_step: Option<(f64, Vec<f64>)>,
+    /// What the elements remembered at the committed state (the solid-shell's last
+    /// linearisation; [`super::assembly::ElementMemory`]), so that a restarted run
+    /// predicts its next local solves as the uninterrupted one does. Unset entries are NaN,
+    /// written as JSON `null`. Absent from older checkpoints (read as empty: the next
+    /// increment's first local solves start cold).
+    #[serde(default, with = "nan_as_null")]
+    pub element_memory: Vec<f64>,
+}
+
+/// A vector of numbers, NaN among them, as JSON (which has no NaN): NaN as `null`.
+mod nan_as_null {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        let opt: Vec<Option<f64>> = v.iter().map(|x| (!x.is_nan()).then_some(*x)).collect();
+        opt.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+        let opt = Vec::<Option<f64>>::deserialize(d)?;
+        Ok(opt.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+    }
 }
 
 /// Sizes and names that must agree between the checkpoint and the rebuilt model.
@@ -216,6 +239,7 @@ impl Checkpoint {
             )));
         }
         let s = &self.state;
+        let remembered = sim.model.element()?.memory_len();
         let shapes_ok = s.x.len() == here.unknowns
             && s.points.len() == sim.points().len()
             && s.contact.len() == here.tools.len()
@@ -223,7 +247,9 @@ impl Checkpoint {
                 .iter()
                 .zip(&here.tools)
                 .all(|(c, t)| c.len() == t.1.len())
-            && s.history_len == self.history.len();
+            && s.history_len == self.history.len()
+            && (s.element_memory.is_empty()
+                || s.element_memory.len() == sim.model.mesh.hexes.len() * remembered);
         if !shapes_ok {
             return Err(Error::Input(
                 "the checkpoint is inconsistent (array sizes do not match its model)".into(),

@@ -94,6 +94,8 @@ pub(super) struct Trial {
     pub(super) times: PhaseTimes,
     pub(super) cycling: Vec<CyclingNode>,
     pub(super) line_search_cuts: usize,
+    /// What the elements remembered at the converged iterate.
+    pub(super) element_memory: Vec<f64>,
 }
 
 /// Nodes listed by name in a cycling message; the rest are counted. On the 50 x 50 x 2
@@ -524,6 +526,7 @@ impl Simulation {
             times: *times,
             cycling: monitor.report(node_of),
             line_search_cuts,
+            element_memory: ctx.element_memory.into_inner(),
         })
     }
 

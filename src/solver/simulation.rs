@@ -71,6 +71,10 @@ pub struct Simulation {
     pub(super) pattern: Arc<SparsePattern>,
     pub(super) is_fixed: Vec<bool>,
     pub(super) linear: Solver,
+    /// What the elements remembered at the last converged iterate (their linearisation
+    /// there), where every attempt of the next increment starts
+    /// ([`super::assembly::ElementMemory`]); empty before the first increment.
+    pub(super) committed_memory: Vec<f64>,
     pub(super) condenser: Option<Condenser>,
     /// Committed unknowns [u, lambda].
     pub(super) x: Vec<f64>,
@@ -173,6 +177,7 @@ impl Simulation {
             pattern,
             is_fixed,
             linear: Solver::new(model.settings.linear_solver),
+            committed_memory: Vec::new(),
             points,
             contact,
             time: 0.0,
@@ -291,7 +296,7 @@ impl Simulation {
             frozen,
             is_fixed: &self.is_fixed,
             forced: None,
-            element_memory: Default::default(),
+            element_memory: self.committed_memory.clone().into(),
             keep_element_jacobian: self.model.settings.status_prediction > 0,
         }
     }
@@ -357,6 +362,7 @@ impl Simulation {
             self.saved.push_back(state);
         }
         self.phase_times.add(&trial.times);
+        self.committed_memory = trial.element_memory;
         let kinematics_warning = (self.model.settings.kinematics
             == crate::element::StrainTheory::Small)
             .then(|| {
@@ -548,6 +554,7 @@ impl Simulation {
             energy_memory: self.energy_memory.clone(),
             controller: self.controller,
             last_step: self.last_step.clone(),
+            element_memory: self.committed_memory.clone(),
         }
     }
 
@@ -564,6 +571,7 @@ impl Simulation {
         self.energy_memory = state.energy_memory;
         self.controller = state.controller;
         self.last_step = state.last_step;
+        self.committed_memory = state.element_memory;
     }
 
     /// Replaces the settings of a running simulation (after a rollback in the REPL, say).
