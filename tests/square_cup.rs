@@ -374,12 +374,15 @@ fn the_default_step_follows_the_cell() {
 
 /// The solid-shell paper cup (25 x 25 x 1) under the engine's Newton budget (30 iterations,
 /// 4 halvings) through its hardest spot, where the flange between die and holder barely
-/// touches either (the holder force falls to its minimum, about 0.8 kN, near 7.8 mm): a
-/// part of the increment ending there fails even at a sixteenth of the step, while the rest
-/// of the increment tried whole and halved afresh gets over it. So fixed stepping tries the
-/// rest whole where a part fails after a converged one (`Simulation::step_fixed`); with
-/// only halvings of the parts, as before, this run stopped at 7.78 mm. The parts are then
-/// not all halves of 0.5 mm: at least one increment is not 0.5 / 2^k.
+/// touches either (the holder force falls to its minimum, about 0.8 kN, near 7.3-7.8 mm):
+/// a part of the increment ending there fails even at a sixteenth of the step. Two things
+/// get over it, depending on round-off (which statuses a failed attempt ends in): the rest
+/// of the increment tried whole and halved afresh (`step_fixed`; parts then not all halves
+/// of 0.5 mm), or the last resorts at the smallest part and then on the rest whole
+/// (module `stepping`; an increment with `last_resort` in its report). Before either, this
+/// run stopped at 7.78 mm; with the elements' memory kept across increments, at 7.28 mm
+/// until the last resorts went on to the rest whole. Either way the run reaches 8 mm
+/// after cutbacks, and every increment converged to the run's tolerances.
 #[test]
 fn the_solid_shell_paper_cup_steps_over_its_flange_lift_off() {
     let out = out_dir("solid_shell_lift_off");
@@ -387,14 +390,11 @@ fn the_solid_shell_paper_cup_steps_over_its_flange_lift_off() {
     let rows = history_columns(&out, &["time", "dt"]);
     assert_eq!(rows.last().expect("increments")[0], 8.0, "{summary}");
     let halves = |dt: f64| (0..12).any(|k| (dt - 0.5 / f64::from(1 << k)).abs() < 1e-12);
-    let parts: Vec<f64> = rows
-        .iter()
-        .map(|r| r[1])
-        .filter(|&dt| !halves(dt))
-        .collect();
+    let parts = rows.iter().filter(|r| !halves(r[1])).count();
+    let resorts = number(&summary, "last_resort_increments");
     assert!(
-        !parts.is_empty(),
-        "every increment a half of 0.5 mm: {rows:?}"
+        parts > 0 || resorts > 0.0,
+        "neither the rest whole nor a last resort stepped over it: {rows:?}"
     );
     assert!(
         number(&summary, "cutbacks") >= 1.0,
