@@ -156,6 +156,29 @@ fn a_stop_after_the_last_resorts_names_every_attempt() {
     assert_final_state(&s, 2);
 }
 
+/// `last_resort: false` turns the last resorts off everywhere, also where fixed stepping
+/// has halved the increment (the resorts would otherwise go on to the rest of it whole).
+#[test]
+fn without_last_resorts_a_halved_increment_stops_with_newton_alone() {
+    let s = run_until_stop(
+        "no_last_resorts",
+        &scene(
+            "0.25",
+            "sim.step(); sim.step(); sim.settings(#{ max_iterations: 1, max_cutbacks: 2, last_resort: false }); sim.step();",
+        ),
+        |_| {},
+    );
+    let reason = s.summary["error"].as_str().unwrap();
+    assert!(reason.contains("increment 3"), "{reason}");
+    assert!(reason.contains("after 2 cutbacks"), "{reason}");
+    assert!(
+        !reason.contains("plain Newton with a longer budget")
+            && !reason.contains("pseudo-transient continuation"),
+        "no last resort was tried: {reason}"
+    );
+    assert_final_state(&s, 2);
+}
+
 #[test]
 fn a_script_error_after_some_increments_stops_with_summary_and_final_checkpoint() {
     let s = run_until_stop(

@@ -204,12 +204,15 @@ impl Simulation {
                             attempt = next;
                         }
                         // Both failed on the smallest part: the last resorts on the rest
-                        // of the increment whole, as the regular attempts do above.
-                        None if retryable(&err) && !resorts_on_rest && t_new < target => {
+                        // of the increment whole, as the regular attempts do above (only
+                        // after the continuation, so never with `last_resort` off).
+                        None if attempt == Attempt::Continuation
+                            && retryable(&err)
+                            && !resorts_on_rest
+                            && t_new < target =>
+                        {
                             failures.push(attempt_failure(attempt, t_new, dt_part, &err));
-                            attempt = Attempt::Regular
-                                .next()
-                                .expect("a regular attempt has a last resort");
+                            attempt = Attempt::LongPlain;
                             resorts_on_rest = true;
                             dt = target - self.time;
                         }
