@@ -65,13 +65,20 @@ fn failure_text(failures: &[String], attempt: Attempt, err: &Error) -> String {
     }
 }
 
-/// The warning of an increment that only a last resort got through.
-fn last_resort_warning(index: usize, t_new: f64, attempt: Attempt, failures: &[String]) -> String {
-    format!(
-        "increment {index} to t = {t_new} converged by the last resort '{}' after {}; the state solves the same equations to the same tolerances (docs/convergence.md, \"When a run stops\")",
+/// Marks the report of an increment that only a last resort got through (its name, and a
+/// warning with the attempts that failed before it); nothing for a regular attempt.
+fn note_last_resort(report: &mut IncrementReport, attempt: Attempt, failures: &[String]) {
+    if attempt == Attempt::Regular {
+        return;
+    }
+    report.last_resort = Some(attempt.name().to_string());
+    report.warnings.push(format!(
+        "increment {} to t = {} converged by the last resort '{}' after {}; the state solves the same equations to the same tolerances (docs/convergence.md, \"When a run stops\")",
+        report.index,
+        report.time,
         attempt.name(),
         failures.join("; ")
-    )
+    ));
 }
 
 /// An error's message without its kind prefix, for nesting in another message.
@@ -145,18 +152,10 @@ impl Simulation {
             match self.try_increment(t_new, attempt) {
                 Ok(trial) => {
                     let mut report = self.accept(t_new, trial);
-                    if attempt != Attempt::Regular {
-                        report.last_resort = Some(attempt.name().to_string());
-                        report.warnings.push(last_resort_warning(
-                            report.index,
-                            t_new,
-                            attempt,
-                            &failures,
-                        ));
-                        attempt = Attempt::Regular;
-                        failures.clear();
-                        resorts_on_rest = false;
-                    }
+                    note_last_resort(&mut report, attempt, &failures);
+                    attempt = Attempt::Regular;
+                    failures.clear();
+                    resorts_on_rest = false;
                     report.cutbacks = cutbacks - recorded;
                     report.cutback_reasons = reasons[recorded..].to_vec();
                     recorded = cutbacks;
@@ -257,12 +256,7 @@ impl Simulation {
                         continue;
                     }
                     let mut report = self.accept(t_new, trial);
-                    if attempt != Attempt::Regular {
-                        report.last_resort = Some(attempt.name().to_string());
-                        report
-                            .warnings
-                            .push(last_resort_warning(report.index, t_new, attempt, &failures));
-                    }
+                    note_last_resort(&mut report, attempt, &failures);
                     report.cutbacks = cutbacks;
                     report.cutback_reasons = std::mem::take(&mut reasons);
                     report.rejected = rejected;
