@@ -510,6 +510,37 @@ fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
     );
 }
 
+/// The iterations of attempts not kept are reported with the increment they preceded:
+/// with a budget of one Newton iteration the drag's first attempts fail after exactly one
+/// step, each once with status prediction and once in its plain retry (at most one
+/// iteration too), until a halved increment converges in one; so an increment's
+/// `discarded_iterations` is twice its cutbacks, and the run's Newton steps (phase
+/// counts) are its iterations plus the discarded ones.
+#[test]
+fn the_iterations_of_discarded_attempts_are_reported() {
+    let mut model = adaptive_drag();
+    model.settings.max_iterations = 1;
+    model.settings.stepping.last_resort = false;
+    let mut sim = Simulation::new(model).unwrap();
+    let mut cutbacks = 0;
+    while sim.time() < 2.0 && sim.history.len() < 12 {
+        let report = sim.step().unwrap();
+        assert_eq!(
+            report.discarded_iterations,
+            2 * report.cutbacks,
+            "increment {}: {} cutbacks ({:?})",
+            report.index,
+            report.cutbacks,
+            report.cutback_reasons
+        );
+        cutbacks += report.cutbacks;
+    }
+    assert!(cutbacks > 0, "no attempt failed: the test checks nothing");
+    let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();
+    let discarded: usize = sim.history.iter().map(|r| r.discarded_iterations).sum();
+    assert_eq!(sim.phase_times.newton_steps, iterations + discarded);
+}
+
 /// Fixed stepping: each history row counts the cutbacks made before it was reached, since
 /// the last converged part, so a row's dt is the previous part's (or the nominal increment's)
 /// or the rest of the nominal increment (tried whole where a part fails after a converged

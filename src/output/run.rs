@@ -127,6 +127,7 @@ impl RunOutput {
             ("slipping_nodes", None),
             ("rejected_steps", None),
             ("line_search_cuts", None),
+            ("discarded_iterations", None),
             ("cycling_nodes", None),
             ("frozen_nodes", None),
             ("step_limit", None),
@@ -259,6 +260,7 @@ impl RunOutput {
             r.slipping_nodes as f64,
             r.rejected as f64,
             r.line_search_cuts as f64,
+            r.discarded_iterations as f64,
             r.cycling.len() as f64,
             r.cycling.iter().filter(|c| c.frozen.is_some()).count() as f64,
             r.limit.code(),
@@ -509,6 +511,7 @@ impl RunOutput {
             },
             "rejected_steps": sim.history.iter().map(|r| r.rejected).sum::<usize>(),
             "line_search_cuts": sim.history.iter().map(|r| r.line_search_cuts).sum::<usize>(),
+            "discarded_iterations": sim.history.iter().map(|r| r.discarded_iterations).sum::<usize>(),
             "increments_with_cycling": sim.history.iter().filter(|r| !r.cycling.is_empty()).count(),
             "step_control": format!("{:?}", settings.stepping.mode).to_lowercase(),
         });

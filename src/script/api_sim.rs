@@ -530,6 +530,10 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
         Dynamic::from(r.line_search_cuts as i64),
     );
     m.insert(
+        "discarded_iterations".into(),
+        Dynamic::from(r.discarded_iterations as i64),
+    );
+    m.insert(
         "cycling_nodes".into(),
         Dynamic::from(
             r.cycling

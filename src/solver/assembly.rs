@@ -340,6 +340,10 @@ pub struct PhaseTimes {
     /// Evaluations (full or residual-only) in which some element stopped its local solve
     /// early ([`LocalSolve::Approximate`]).
     pub approximate_evaluations: usize,
+    /// Newton steps solved (a correction computed and searched along), in every attempt:
+    /// those of an accepted attempt are its iterations; a failed attempt's include the step
+    /// it failed in.
+    pub newton_steps: usize,
 }
 
 impl PhaseTimes {
@@ -352,6 +356,7 @@ impl PhaseTimes {
         self.residual_evaluations += other.residual_evaluations;
         self.jacobian_completions += other.jacobian_completions;
         self.approximate_evaluations += other.approximate_evaluations;
+        self.newton_steps += other.newton_steps;
     }
 }
 

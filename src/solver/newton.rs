@@ -457,6 +457,7 @@ impl Simulation {
                     cycling_note()
                 )));
             }
+            times.newton_steps += 1;
             let ts = Instant::now();
             let dx = match (next_step.take(), continuation.as_mut()) {
                 (Some(dx), _) => dx,

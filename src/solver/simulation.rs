@@ -62,6 +62,12 @@ pub struct IncrementReport {
     /// smallest part the cut-backs allow (module `stepping`); `None` for Newton's own.
     #[serde(default)]
     pub last_resort: Option<String>,
+    /// Newton iterations (steps solved) of the attempts not kept before this increment
+    /// converged: attempts cut back, a status-prediction attempt retried plainly, failed
+    /// last resorts, converged trials the step control rejected. Their work is the run's
+    /// (phase times) but not in `iterations`.
+    #[serde(default)]
+    pub discarded_iterations: usize,
 }
 
 /// Model plus its evolving, committed solution.
@@ -100,6 +106,9 @@ pub struct Simulation {
     pub(super) interrupt: crate::interrupt::Interrupt,
     /// Whether the run has explained contact-status cycling to the user (once per run).
     pub(super) cycling_explained: bool,
+    /// Newton steps of attempts not kept since the last accepted increment
+    /// ([`IncrementReport::discarded_iterations`]).
+    pub(super) discarded_steps: usize,
     /// Whether the run has explained a step limit exceeded at the minimum step (in full
     /// once per run; later increments get one short line each).
     pub(super) limit_explained: bool,
@@ -191,6 +200,7 @@ impl Simulation {
             last_step: None,
             interrupt: crate::interrupt::Interrupt::new(),
             cycling_explained: false,
+            discarded_steps: 0,
             limit_explained: false,
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
@@ -362,6 +372,10 @@ impl Simulation {
             self.saved.push_back(state);
         }
         self.phase_times.add(&trial.times);
+        // The accepted attempt's steps are its iterations; the rest of its `times` (a
+        // status-prediction attempt before a plain retry) was discarded.
+        let discarded = std::mem::take(&mut self.discarded_steps)
+            + trial.times.newton_steps.saturating_sub(trial.iterations);
         self.committed_memory = trial.element_memory;
         let kinematics_warning = (self.model.settings.kinematics
             == crate::element::StrainTheory::Small)
@@ -381,6 +395,7 @@ impl Simulation {
             trial.residuals,
         );
         report.line_search_cuts = trial.line_search_cuts;
+        report.discarded_iterations = discarded;
         report.warnings.extend(kinematics_warning);
         // Cycling is worth one explanation per run, not one line per increment: the nodes
         // of every increment are in its report and in history.csv (cycling_nodes).
@@ -538,6 +553,7 @@ impl Simulation {
             warnings: Vec::new(),
             cutback_reasons: Vec::new(),
             last_resort: None,
+            discarded_iterations: 0,
         }
     }
 

@@ -251,6 +251,7 @@ impl Simulation {
                     // A last resort's state is taken as it is: a smaller step is not allowed.
                     if !verdict.accept && attempt == Attempt::Regular {
                         self.phase_times.add(&trial.times);
+                        self.discarded_steps += trial.times.newton_steps;
                         rejected += 1;
                         dt = verdict.next_dt;
                         continue;
@@ -373,6 +374,7 @@ impl Simulation {
         }
         if outcome.is_err() {
             self.phase_times.add(&spent);
+            self.discarded_steps += spent.newton_steps;
         }
         self.linear = linear;
         outcome
