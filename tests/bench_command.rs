@@ -79,6 +79,7 @@ fn reported_counts_are_the_runs_own() {
         let summary = summary_of(m);
         for field in [
             "newton_iterations",
+            "discarded_iterations",
             "line_search_cuts",
             "increments",
             "nodes",

@@ -93,6 +93,9 @@ pub struct Measurement {
     pub displacement_unknowns: usize,
     pub increments: usize,
     pub newton_iterations: usize,
+    /// Newton iterations of the attempts not kept (cut back, retried, rejected), not in
+    /// `newton_iterations` (None for a binary that does not count them).
+    pub discarded_iterations: Option<usize>,
     pub line_search_cuts: usize,
     /// Trial states evaluated per Newton iteration, (iterations + cuts) / iterations: the
     /// full step and each cut (predictors and re-evaluations not counted).
@@ -417,6 +420,7 @@ fn measure(
         displacement_unknowns: 3 * nodes,
         increments: count("increments")?,
         newton_iterations,
+        discarded_iterations: summary["discarded_iterations"].as_u64().map(|v| v as usize),
         line_search_cuts,
         trials_per_iteration: (newton_iterations + line_search_cuts) as f64 / iterations,
         full_evaluations_per_iteration: per_iteration("full"),
@@ -462,13 +466,14 @@ fn table(result: &CaseResult) -> String {
         None => "all processors".to_string(),
     };
     let mut s = format!(
-        "\ncase {} ({}; {threads})\n{:<9} {:>7} {:>5} {:>6} {:>5} {:>16}",
+        "\ncase {} ({}; {threads})\n{:<9} {:>7} {:>5} {:>6} {:>6} {:>5} {:>16}",
         result.case.name,
         result.case.sets.join(" "),
         "binary",
         "u dofs",
         "incr",
         "iters",
+        "disc",
         "cuts",
         "evals/it f+r+c"
     );
@@ -480,8 +485,11 @@ fn table(result: &CaseResult) -> String {
         "cpu s", "wall s", "cpu ms/it", "wall ms/it"
     );
     let row = |label: &str, m: &Measurement| {
+        let discarded = m
+            .discarded_iterations
+            .map_or("-".to_string(), |d| d.to_string());
         let mut r = format!(
-            "{label:<9} {:>7} {:>5} {:>6} {:>5} {:>16}",
+            "{label:<9} {:>7} {:>5} {:>6} {discarded:>6} {:>5} {:>16}",
             m.displacement_unknowns,
             m.increments,
             m.newton_iterations,
@@ -516,8 +524,8 @@ fn table(result: &CaseResult) -> String {
         };
         let t = &result.this;
         let mut r = format!(
-            "{:<9} {:>7} {:>5} {:>6} {:>5} {:>16}",
-            "base/this", "", "", "", "", ""
+            "{:<9} {:>7} {:>5} {:>6} {:>6} {:>5} {:>16}",
+            "base/this", "", "", "", "", "", ""
         );
         for p in &phases {
             match (t.phase_times_s.get(p), b.phase_times_s.get(p)) {
@@ -551,7 +559,8 @@ fn table(result: &CaseResult) -> String {
     s += "evals/it f+r+c: element evaluations per accepted Newton iteration, full (with \
           tangents) + residual-only (line-search trials) + completed (residual-only ones given \
           their Jacobian afterwards: an accepted cut); evaluations and phase seconds include \
-          the attempts that failed and were cut back\n";
+          the attempts that failed and were cut back; disc: Newton iterations of those attempts \
+          (not in iters)\n";
     s
 }
 
