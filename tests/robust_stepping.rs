@@ -515,30 +515,52 @@ fn adaptive_stop_at_the_minimum_step_names_the_reason_and_keeps_the_state() {
 /// step, each once with status prediction and once in its plain retry (at most one
 /// iteration too), until a halved increment converges in one; so an increment's
 /// `discarded_iterations` is twice its cutbacks, and the run's Newton steps (phase
-/// counts) are its iterations plus the discarded ones.
+/// counts) are its iterations plus the discarded ones. Under fixed stepping the report
+/// `step` returns covers the nominal increment's parts, and so do both counts; each history
+/// row, its own part.
 #[test]
 fn the_iterations_of_discarded_attempts_are_reported() {
-    let mut model = adaptive_drag();
-    model.settings.max_iterations = 1;
-    model.settings.stepping.last_resort = false;
-    let mut sim = Simulation::new(model).unwrap();
-    let mut cutbacks = 0;
-    while sim.time() < 2.0 && sim.history.len() < 12 {
-        let report = sim.step().unwrap();
-        assert_eq!(
-            report.discarded_iterations,
-            2 * report.cutbacks,
-            "increment {}: {} cutbacks ({:?})",
-            report.index,
-            report.cutbacks,
-            report.cutback_reasons
+    for mode in [StepMode::Adaptive, StepMode::Fixed] {
+        let mut model = adaptive_drag();
+        model.settings.stepping.mode = mode;
+        model.settings.max_iterations = 1;
+        model.settings.max_cutbacks = 8;
+        model.settings.stepping.last_resort = false;
+        let mut sim = Simulation::new(model).unwrap();
+        let mut cutbacks = 0;
+        while !sim.is_finished() && sim.history.len() < 12 {
+            let report = sim.step().unwrap();
+            assert_eq!(
+                report.discarded_iterations,
+                2 * report.cutbacks,
+                "{mode:?}, increment {}: {} cutbacks ({:?})",
+                report.index,
+                report.cutbacks,
+                report.cutback_reasons
+            );
+            cutbacks += report.cutbacks;
+        }
+        assert!(
+            cutbacks > 0,
+            "{mode:?}: no attempt failed: the test checks nothing"
         );
-        cutbacks += report.cutbacks;
+        for row in &sim.history {
+            assert_eq!(
+                row.discarded_iterations,
+                2 * row.cutbacks,
+                "{mode:?}: row {}",
+                row.index
+            );
+        }
+        let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();
+        let discarded: usize = sim.history.iter().map(|r| r.discarded_iterations).sum();
+        assert_eq!(discarded, 2 * cutbacks, "{mode:?}");
+        assert_eq!(
+            sim.phase_times.newton_steps,
+            iterations + discarded,
+            "{mode:?}"
+        );
     }
-    assert!(cutbacks > 0, "no attempt failed: the test checks nothing");
-    let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();
-    let discarded: usize = sim.history.iter().map(|r| r.discarded_iterations).sum();
-    assert_eq!(sim.phase_times.newton_steps, iterations + discarded);
 }
 
 /// Fixed stepping: each history row counts the cutbacks made before it was reached, since

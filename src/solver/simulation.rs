@@ -65,7 +65,8 @@ pub struct IncrementReport {
     /// Newton iterations (steps solved) of the attempts not kept before this increment
     /// converged: attempts cut back, a status-prediction attempt retried plainly, failed
     /// last resorts, converged trials the step control rejected. Their work is the run's
-    /// (phase times) but not in `iterations`.
+    /// (phase times) but not in `iterations`. Like `cutbacks`: per part in `history`, over
+    /// the nominal increment's parts in the report fixed stepping's `step` returns.
     #[serde(default)]
     pub discarded_iterations: usize,
 }

@@ -134,6 +134,8 @@ impl Simulation {
             .dt_min(self.model.settings.end_time);
         let mut dt = target - self.time;
         let (mut cutbacks, mut in_a_row, mut recorded) = (0, 0, 0);
+        // Over the parts, as `cutbacks` (the rows in `history` have each part's own).
+        let mut discarded = 0;
         let start = self.time;
         let mut rest_tried = false;
         let mut reasons = Vec::new();
@@ -159,6 +161,7 @@ impl Simulation {
                     report.cutbacks = cutbacks - recorded;
                     report.cutback_reasons = reasons[recorded..].to_vec();
                     recorded = cutbacks;
+                    discarded += report.discarded_iterations;
                     self.history.push(report.clone());
                     if t_new < target {
                         // The next part keeps this one's size; the rest is tried whole only
@@ -169,6 +172,7 @@ impl Simulation {
                     }
                     report.cutbacks = cutbacks;
                     report.cutback_reasons = reasons;
+                    report.discarded_iterations = discarded;
                     return Ok(report);
                 }
                 Err(err @ Error::Interrupted(_)) => return Err(err),
@@ -250,8 +254,7 @@ impl Simulation {
                         .assess(&step, end, dt_used, &measures, trial.iterations);
                     // A last resort's state is taken as it is: a smaller step is not allowed.
                     if !verdict.accept && attempt == Attempt::Regular {
-                        self.phase_times.add(&trial.times);
-                        self.discarded_steps += trial.times.newton_steps;
+                        self.discard(&trial.times);
                         rejected += 1;
                         dt = verdict.next_dt;
                         continue;
@@ -329,6 +332,14 @@ impl Simulation {
         m
     }
 
+    /// Counts the work of an attempt not kept (failed, or rejected by the step control):
+    /// the run's phase times, and the Newton steps the next accepted increment reports as
+    /// discarded.
+    fn discard(&mut self, times: &PhaseTimes) {
+        self.phase_times.add(times);
+        self.discarded_steps += times.newton_steps;
+    }
+
     /// The attempt after `attempt` failed with `err` at the smallest part, if any.
     fn next_attempt(&self, attempt: Attempt, err: &Error) -> Option<Attempt> {
         if !(retryable(err) && self.model.settings.stepping.last_resort) {
@@ -373,8 +384,7 @@ impl Simulation {
             );
         }
         if outcome.is_err() {
-            self.phase_times.add(&spent);
-            self.discarded_steps += spent.newton_steps;
+            self.discard(&spent);
         }
         self.linear = linear;
         outcome
