@@ -330,7 +330,7 @@ impl Simulation {
         // force residual from the second iterate on, while 44 of the 76 that failed passed 3
         // times and then spent 377 iterations before their end, at force residuals of
         // 1e4-1e5 N where the solution's internal forces are 200 N; on the solid-shell
-        // benchmark cup the converged attempts stayed within 0.56 times. The first step may
+        // benchmark cup the converged attempts stayed within 0.93 times. The first step may
         // raise it more (a bent sheet's membrane forces: up to 5.1 times on that cup, in
         // attempts that converged). A run of merit increases, the guard without force
         // control, ended few of the U-channel's failing attempts.
