@@ -26,9 +26,8 @@ fn scripts_read_cad_tools_with_options() {
         "#
     );
     // The JSON table beside the script (its folder is readable).
-    let dir_of = std::env::temp_dir().join(format!("tribo-cad-{}-ok", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir_of);
-    std::fs::create_dir_all(&dir_of).unwrap();
+    let dir_of = common::TestDir::new(&format!("tribo-cad-{}-ok", std::process::id()));
+    std::fs::create_dir_all(&*dir_of).unwrap();
     std::fs::write(dir_of.join("plate.json"), plate).unwrap();
     let path = dir_of.join("ok.rhai");
     std::fs::write(&path, source).unwrap();

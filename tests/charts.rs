@@ -3,6 +3,8 @@
 //! face, each with its CSV, and adds entries to summary.json; paths that would leave the
 //! output folder are refused.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use tribo::script::{self, HostOptions};
 
@@ -18,10 +20,11 @@ sim.fix("y-", "y");
 sim.settings(#{ end_time: 2.0, increments: 4 });
 "#;
 
-fn run(name: &str, body: &str) -> (PathBuf, tribo::Result<()>) {
-    let dir = std::env::temp_dir().join(format!("tribo-charts-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+/// Runs the scene with `body` after it; the run's folder (removed when the test passes), its
+/// `out` and the outcome.
+fn run(name: &str, body: &str) -> (common::TestDir, PathBuf, tribo::Result<()>) {
+    let dir = common::TestDir::new(&format!("tribo-charts-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&*dir).unwrap();
     let script = dir.join("case.rhai");
     std::fs::write(&script, format!("{SCENE}\n{body}")).unwrap();
     let out = dir.join("out");
@@ -30,7 +33,7 @@ fn run(name: &str, body: &str) -> (PathBuf, tribo::Result<()>) {
         ..HostOptions::default()
     };
     let result = script::run_file(&script, &[], &host);
-    (out, result)
+    (dir, out, result)
 }
 
 fn read(p: &Path) -> String {
@@ -39,7 +42,7 @@ fn read(p: &Path) -> String {
 
 #[test]
 fn script_writes_charts_with_csv_and_summary_entries() {
-    let (out, result) = run(
+    let (_dir, out, result) = run(
         "ok",
         r#"
 let t = []; let s = [];
@@ -109,7 +112,7 @@ fn chart_paths_outside_the_output_folder_are_refused() {
         ("/tmp/escape.svg", "absolute"),
         ("charts/x.png", "must end in .svg"),
     ] {
-        let (out, result) = run(
+        let (_dir, out, result) = run(
             "refuse",
             &format!(
                 "line_chart(\"{file}\", #{{ series: [#{{ name: \"a\", x: [0], y: [1] }}] }});"
@@ -118,7 +121,7 @@ fn chart_paths_outside_the_output_folder_are_refused() {
         let err = result.unwrap_err().to_string();
         assert!(err.contains(why), "{file}: {err}");
         assert!(!out.parent().unwrap().join("escape.svg").exists());
-        let (_, result) = run(
+        let (_, _, result) = run(
             "refuse-field",
             &format!("sim.chart_field(\"{file}\", \"z+\", \"mu\");"),
         );
@@ -159,7 +162,7 @@ fn bad_chart_and_summary_input_is_reported() {
         ),
         ("sim.summary(\"f\", |x| x);", "summary value f is a Fn"),
     ] {
-        let (_, result) = run("bad", body);
+        let (_, _, result) = run("bad", body);
         let err = result.unwrap_err().to_string();
         assert!(err.contains(message), "{body}: {err}");
     }

@@ -88,12 +88,12 @@ fn missing_script_is_an_error() {
 fn repl_loads_a_scene_and_steps_it() {
     use std::io::Write;
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scripts/cylinder_drag.rhai");
-    let out = std::env::temp_dir().join(format!("tribo-repl-{}", std::process::id()));
+    let out = common::TestDir::new(&format!("tribo-repl-{}", std::process::id()));
     let mut child = Command::new(env!("CARGO_BIN_EXE_tribo"))
         .arg("repl")
         .arg(&script)
         .arg("--out")
-        .arg(&out)
+        .arg(&*out)
         .stdin(std::process::Stdio::piped())
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())

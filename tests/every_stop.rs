@@ -5,14 +5,16 @@
 //! other files are still written. And (item 11) `--restart` with a script that starts no
 //! simulation is refused instead of ignored.
 
+mod common;
+
+use common::TestDir;
 use std::path::{Path, PathBuf};
 use tribo::script::{self, HostOptions};
 use tribo::solver::checkpoint::Checkpoint;
 
-fn out_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tribo-stop-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
+fn out_dir(name: &str) -> TestDir {
+    let d = TestDir::new(&format!("tribo-stop-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&*d).unwrap();
     d
 }
 
@@ -37,6 +39,8 @@ struct Stopped {
     error: String,
     summary: serde_json::Value,
     dir: PathBuf,
+    /// The run's folder (`dir` is its `out`), removed when the test passes.
+    _root: TestDir,
 }
 
 fn run_until_stop(name: &str, script_text: &str, prepare: impl FnOnce(&Path)) -> Stopped {
@@ -61,6 +65,7 @@ fn run_until_stop(name: &str, script_text: &str, prepare: impl FnOnce(&Path)) ->
         error,
         summary: serde_json::from_str(&text).unwrap(),
         dir: out,
+        _root: dir,
     }
 }
 

@@ -159,15 +159,16 @@ fn mu_at_and_charts_refuse_non_finite_values() {
     );
     let chart =
         "line_chart(\"c.svg\", #{ series: [#{ name: \"a\", x: [0.0, 1.0], y: [0.0, 1e308] }] });\n";
-    let (code, err) = run("chart", chart, &[]);
+    let (code, err, dir) = common::run_script_in("item11", "chart", chart, &[]);
     assert_eq!(code, 1);
     assert!(
         err.contains("series[0].y[1] = 100000000000000000000")
             || err.contains("series[0].y[1] = 1e308"),
         "{err}"
     );
-    let dir = std::env::temp_dir().join(format!("tribo-item11-{}-chart/out", std::process::id()));
-    assert!(!dir.join("c.svg").exists() && !dir.join("c.csv").exists());
+    let out = dir.join("out");
+    assert!(out.is_dir(), "the run's output folder exists");
+    assert!(!out.join("c.svg").exists() && !out.join("c.csv").exists());
 }
 
 #[test]

@@ -3,7 +3,9 @@
 //! a 1e308 path are refused or bounded, output size is capped, and endless script loops stop
 //! with the limit's message, quickly.
 
-use std::path::PathBuf;
+mod common;
+
+use common::TestDir;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -13,18 +15,14 @@ struct Outcome {
     /// Peak resident memory of the child, bytes (from `wait4`).
     peak: u64,
     wall: Duration,
+    /// The run's folder (script, stderr and the run's `out`), removed when the test passes.
+    dir: TestDir,
 }
 
-/// The folder of the run tagged `tag` (script, stderr, and the run's `out`).
-fn run_dir(tag: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("tribo-res-{}-{tag}", std::process::id()))
-}
-
-/// [`run_dir`], emptied.
-fn dir(tag: &str) -> PathBuf {
-    let d = run_dir(tag);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
+/// The folder of the run tagged `tag` (script, stderr, and the run's `out`), empty.
+fn dir(tag: &str) -> TestDir {
+    let d = TestDir::new(&format!("tribo-res-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&*d).unwrap();
     d
 }
 
@@ -72,6 +70,7 @@ fn run(tag: &str, source: &str, extra: &[&str]) -> Outcome {
         stderr,
         peak: usage.ru_maxrss as u64 * 1024,
         wall,
+        dir: d,
     }
 }
 
@@ -187,7 +186,7 @@ fn increments_and_paths_are_bounded() {
         o.stderr
     );
     assert!(o.wall < Duration::from_secs(60), "{:?}", o.wall);
-    let out = run_dir("1e308").join("out");
+    let out = o.dir.join("out");
     assert!(
         folder_bytes(&out) < 1 << 20,
         "{} bytes written",
@@ -248,7 +247,7 @@ fn output_size_is_capped() {
         "{}",
         o.stderr
     );
-    let written: u64 = std::fs::read_dir(run_dir("disk").join("out"))
+    let written: u64 = std::fs::read_dir(o.dir.join("out"))
         .unwrap()
         .map(|e| e.unwrap().metadata().unwrap().len())
         .sum();
@@ -257,6 +256,4 @@ fn output_size_is_capped() {
         written <= (8 << 20) + (512 << 10),
         "{written} bytes written"
     );
-    // The 8 MB written are not left in the system's temp folder.
-    let _ = std::fs::remove_dir_all(run_dir("disk"));
 }

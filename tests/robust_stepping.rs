@@ -4,16 +4,15 @@
 
 mod common;
 
+use common::TestDir;
 use std::path::{Path, PathBuf};
 use tribo::output::read_vtu_point_field;
 use tribo::script::{self, HostOptions};
 use tribo::solver::checkpoint::Checkpoint;
 use tribo::solver::{Simulation, StepMode};
 
-fn out_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tribo-robust-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn out_dir(name: &str) -> TestDir {
+    TestDir::new(&format!("tribo-robust-{}-{name}", std::process::id()))
 }
 
 /// Output to `dir`, warnings not printed.
@@ -155,8 +154,6 @@ fn scripted_restart_continues_from_a_written_checkpoint() {
             .count()
     };
     assert_eq!(rows(&full_dir), rows(&rest_dir));
-    let _ = std::fs::remove_dir_all(&full_dir);
-    let _ = std::fs::remove_dir_all(&rest_dir);
 }
 
 #[test]
@@ -179,9 +176,11 @@ fn rollback_returns_to_the_previous_converged_state() {
     assert!(err.contains("rollback_depth"), "{err}");
 }
 
-fn run_inline(name: &str, source: &str) -> Result<PathBuf, String> {
+/// Runs `source` as a script in a folder of its own; the folder (removed when the test
+/// passes) and the run's output folder or its error.
+fn run_inline(name: &str, source: &str) -> (TestDir, Result<PathBuf, String>) {
     let dir = out_dir(name);
-    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::create_dir_all(&*dir).unwrap();
     let path = dir.join(format!("{name}.rhai"));
     std::fs::write(&path, source).unwrap();
     let out = dir.join("out");
@@ -189,32 +188,44 @@ fn run_inline(name: &str, source: &str) -> Result<PathBuf, String> {
         out_dir: out.clone(),
         ..HostOptions::default()
     };
-    script::run_file(&path, &[], &host)
+    let result = script::run_file(&path, &[], &host)
         .map(|_| out)
-        .map_err(|e| e.to_string())
+        .map_err(|e| e.to_string());
+    (dir, result)
 }
 
 #[test]
 fn scripts_cannot_write_outside_their_output_folder() {
-    let err = run_inline("abs", "write_text(\"/tmp/x\", \"hello\");").unwrap_err();
+    let err = run_inline("abs", "write_text(\"/tmp/x\", \"hello\");")
+        .1
+        .unwrap_err();
     assert!(
         err.contains("\"/tmp/x\"") && err.contains("absolute paths are refused"),
         "{err}"
     );
-    let err = run_inline("dotdot", "write_text(\"../x\", \"hello\");").unwrap_err();
+    let err = run_inline("dotdot", "write_text(\"../x\", \"hello\");")
+        .1
+        .unwrap_err();
     assert!(err.contains("\"../x\"") && err.contains("'..'"), "{err}");
-    let err = run_inline("nested", "write_text(\"notes/../../x\", \"hello\");").unwrap_err();
+    let err = run_inline("nested", "write_text(\"notes/../../x\", \"hello\");")
+        .1
+        .unwrap_err();
     assert!(err.contains("'..'"), "{err}");
     // Checkpoints go through the same guard.
     let scene =
         "let sim = simulation(block([0,0,0],[1,1,1],[1,1,1]), linear_elastic(1000.0, 0.3));\n\
                  sim.fix(\"z-\", \"xyz\");\n";
-    let err = run_inline("ck", &format!("{scene}sim.checkpoint(\"/tmp/x\");")).unwrap_err();
+    let err = run_inline("ck", &format!("{scene}sim.checkpoint(\"/tmp/x\");"))
+        .1
+        .unwrap_err();
     assert!(err.contains("absolute paths are refused"), "{err}");
-    let err = run_inline("ck2", &format!("{scene}sim.checkpoint(\"../x\");")).unwrap_err();
+    let err = run_inline("ck2", &format!("{scene}sim.checkpoint(\"../x\");"))
+        .1
+        .unwrap_err();
     assert!(err.contains("'..'"), "{err}");
     // A relative path lands below the output folder.
-    let out = run_inline("ok", "write_text(\"notes/a.txt\", \"hello\");").unwrap();
+    let (_dir, out) = run_inline("ok", "write_text(\"notes/a.txt\", \"hello\");");
+    let out = out.unwrap();
     assert_eq!(
         std::fs::read_to_string(out.join("notes/a.txt")).unwrap(),
         "hello"
@@ -224,11 +235,17 @@ fn scripts_cannot_write_outside_their_output_folder() {
 
 #[test]
 fn script_size_and_depth_limits_stop_with_a_clear_message() {
-    let err = run_inline("string", "let s = \"x\"; loop { s += s; }").unwrap_err();
+    let err = run_inline("string", "let s = \"x\"; loop { s += s; }")
+        .1
+        .unwrap_err();
     assert!(err.to_lowercase().contains("length of string"), "{err}");
-    let err = run_inline("array", "let a = [1]; loop { a += a; }").unwrap_err();
+    let err = run_inline("array", "let a = [1]; loop { a += a; }")
+        .1
+        .unwrap_err();
     assert!(err.to_lowercase().contains("size of array"), "{err}");
-    let err = run_inline("depth", "fn f(n) { f(n + 1) }\nf(0);").unwrap_err();
+    let err = run_inline("depth", "fn f(n) { f(n + 1) }\nf(0);")
+        .1
+        .unwrap_err();
     assert!(
         err.to_lowercase().contains("stack overflow") || err.contains("call"),
         "{err}"
@@ -318,8 +335,6 @@ fn fast_drag_fails_with_fixed_steps_and_completes_with_adaptive_steps() {
         total,
         "one reason per cutback: {reasons:?}"
     );
-    let _ = std::fs::remove_dir_all(&fixed_dir);
-    let _ = std::fs::remove_dir_all(&adaptive_dir);
 }
 
 /// High friction (mu = 0.5), oblique drag of a small ball, full Newton steps: a node at the
@@ -335,7 +350,7 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
     let run_predicted = |mode: &str, line_search: bool, rounds: usize| {
         let dir = out_dir(&format!("cycling-{mode}-{line_search}-{rounds}"));
         let host = HostOptions {
-            out_dir: dir.clone(),
+            out_dir: dir.to_path_buf(),
             ..HostOptions::default()
         };
         let sets = [
@@ -349,7 +364,7 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
     };
     let run_with = |mode: &str, line_search: bool| run_predicted(mode, line_search, 0);
     let run = |mode: &str| run_with(mode, false);
-    let (off, off_dir) = run("off");
+    let (off, _off_dir) = run("off");
     let err = off.unwrap_err().to_string();
     println!("without anti-cycling: {err}");
     assert!(err.contains("status cycling at"), "{err}");
@@ -384,10 +399,6 @@ fn anti_cycling_makes_a_high_friction_drag_converge() {
         iterations.iter().all(|&i| i <= 12.0),
         "converges in a few iterations: {iterations:?}"
     );
-    let _ = std::fs::remove_dir_all(&off_dir);
-    let _ = std::fs::remove_dir_all(&on_dir);
-    let _ = std::fs::remove_dir_all(&searched_dir);
-    let _ = std::fs::remove_dir_all(&predicted_dir);
 }
 
 /// The REPL steps, rolls back to the previous converged increment, switches to adaptive
@@ -402,7 +413,7 @@ fn repl_rolls_back_and_changes_a_setting_before_stepping_on() {
         .arg("repl")
         .arg(&script)
         .arg("--out")
-        .arg(&out)
+        .arg(&*out)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -444,7 +455,6 @@ fn repl_rolls_back_and_changes_a_setting_before_stepping_on() {
         1 + 3,
         "header + 2 kept + 1 new row"
     );
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]
@@ -452,7 +462,7 @@ fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
     use std::process::Command;
     let script = robust_script("restart_drag.rhai");
     let dir = out_dir("bad-restart");
-    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::create_dir_all(&*dir).unwrap();
     let run = |ck: &Path| {
         let out = Command::new(env!("CARGO_BIN_EXE_tribo"))
             .args(["run", "--quiet", "--restart"])
@@ -475,7 +485,6 @@ fn restart_from_a_missing_or_foreign_checkpoint_is_a_clear_error() {
     std::fs::write(&foreign, "{\"format\": \"something else\"}").unwrap();
     let err = run(&foreign);
     assert!(err.contains("is not a tribo checkpoint"), "{err}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// When the increment cannot be completed at the minimum step the run stops with the
@@ -638,5 +647,4 @@ fn fixed_step_cutbacks_are_counted_once() {
             );
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -3,11 +3,13 @@
 
 mod common;
 
+use common::TestDir;
 use std::path::PathBuf;
 use tribo::script::{self, HostOptions};
 
-fn out_dir(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("tribo-scripted-{}-{name}", std::process::id()))
+/// The output folder of case `name`, removed when the test passes.
+fn out_dir(name: &str) -> TestDir {
+    TestDir::new(&format!("tribo-scripted-{}-{name}", std::process::id()))
 }
 
 #[test]
@@ -20,12 +22,16 @@ fn every_scripted_case_passes() {
         dir.display()
     );
     let mut failures = Vec::new();
+    // Kept until the end: a failure leaves every case's output for inspection.
+    let mut outputs = Vec::new();
     for path in &scripts {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let out = out_dir(&name);
         let host = HostOptions {
-            out_dir: out_dir(&name),
+            out_dir: out.to_path_buf(),
             ..HostOptions::default()
         };
+        outputs.push(out);
         match script::run_file(path, &[], &host) {
             Ok(()) => println!("ok    {name}"),
             Err(e) => {

@@ -3,6 +3,40 @@
 
 pub mod pty;
 
+/// A test's output folder in the system's temporary folder: emptied when made, removed when
+/// the test passes (the guard dropped without a panic), kept for inspection when it fails.
+pub struct TestDir(std::path::PathBuf);
+
+impl TestDir {
+    /// `name` under the system's temporary folder.
+    pub fn new(name: &str) -> TestDir {
+        let path = std::env::temp_dir().join(name);
+        let _ = std::fs::remove_dir_all(&path);
+        TestDir(path)
+    }
+}
+
+impl std::ops::Deref for TestDir {
+    type Target = std::path::Path;
+    fn deref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::path::Path> for TestDir {
+    fn as_ref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl Drop for TestDir {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
 use std::sync::Arc;
 use tribo::contact::FrictionLaw;
 use tribo::geometry::{RigidSurface, Vec3};
@@ -175,12 +209,23 @@ pub fn former_default_r(
 }
 
 /// Runs `source` as the script `name.rhai` through the `tribo run` command line (output in a
-/// fresh folder under the system temp, `tag` keeping test files apart), with `extra`
-/// arguments; returns the exit code and stderr, and fails on a panic.
+/// fresh folder under the system temp, `tag` keeping test files apart, removed when the test
+/// passes), with `extra` arguments; returns the exit code and stderr, and fails on a panic.
 pub fn run_script(tag: &str, name: &str, source: &str, extra: &[&str]) -> (i32, String) {
-    let dir = std::env::temp_dir().join(format!("tribo-{tag}-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let (code, stderr, _dir) = run_script_in(tag, name, source, extra);
+    (code, stderr)
+}
+
+/// [`run_script`], also returning its folder (the script and the run's `out`), for a test
+/// that looks into it.
+pub fn run_script_in(
+    tag: &str,
+    name: &str,
+    source: &str,
+    extra: &[&str],
+) -> (i32, String, TestDir) {
+    let dir = TestDir::new(&format!("tribo-{tag}-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&*dir).unwrap();
     let path = dir.join(format!("{name}.rhai"));
     std::fs::write(&path, source).unwrap();
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
@@ -193,7 +238,7 @@ pub fn run_script(tag: &str, name: &str, source: &str, extra: &[&str]) -> (i32, 
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(!stderr.contains("panicked"), "{name}: panic: {stderr}");
-    (out.status.code().unwrap_or(-1), stderr)
+    (out.status.code().unwrap_or(-1), stderr, dir)
 }
 
 /// The `*.rhai` files of `tests/<folder>`, sorted by name.
