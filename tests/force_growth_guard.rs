@@ -7,15 +7,8 @@
 
 mod common;
 
+use common::TestDir;
 use serde_json::Value;
-use std::path::PathBuf;
-
-fn out_dir(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("tribo_force_growth_{name}_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 fn reasons(summary: &Value) -> Vec<String> {
     summary["cutback_reasons"]
@@ -33,7 +26,10 @@ fn reasons(summary: &Value) -> Vec<String> {
 /// converges in one attempt of 30 iterations.
 #[test]
 fn the_guard_waits_for_the_holder_force_to_come_on() {
-    let out = out_dir("cup_first");
+    let out = TestDir::new(&format!(
+        "tribo_force_growth_cup_first_{}",
+        std::process::id()
+    ));
     let sets = [
         "travel=0.5".to_string(),
         "variant=\"benchmark\"".to_string(),
@@ -47,5 +43,4 @@ fn the_guard_waits_for_the_holder_force_to_come_on() {
     );
     assert_eq!(s["cutbacks"].as_u64(), Some(0), "{:?}", reasons(&s));
     assert_eq!(s["discarded_iterations"].as_u64(), Some(0));
-    let _ = std::fs::remove_dir_all(&out);
 }

@@ -458,11 +458,11 @@ impl Simulation {
             // Growth is measured from the first residual above the tolerance: an increment
             // driven only by a force-controlled tool starts from a zero (or round-off) force
             // residual, which is no scale for growth.
-            let first = residuals
+            let first_record = residuals
                 .iter()
-                .map(|r| r.force_rel)
-                .find(|&v| v > settings.force_rel_tol)
-                .unwrap_or(f64::INFINITY);
+                .find(|r| r.force_rel > settings.force_rel_tol);
+            let first = first_record.map_or(f64::INFINITY, |r| r.force_rel);
+            let first_force = first_record.map_or(f64::INFINITY, |r| r.force);
             let first_merit = merits.iter().copied().find(|&v| v > 0.0).unwrap_or(0.0);
             let grew = attempt == Attempt::Regular
                 && !force_controlled
@@ -481,10 +481,6 @@ impl Simulation {
                     cycling_note()
                 )));
             }
-            let first_force = residuals
-                .iter()
-                .find(|r| r.force_rel > settings.force_rel_tol)
-                .map_or(f64::INFINITY, |r| r.force);
             if attempt == Attempt::Regular
                 && forces_on
                 && iterations >= 2
