@@ -6,23 +6,30 @@
 //! sign of `sigma_n`, so with r far above the stiffness that actually resists the node's
 //! motion a gap error of round-off size flips the status of a barely touching node, and the
 //! active-set search chatters; with r far below it the multiplier rows dominate and the gap
-//! closes slowly. The stiffness a sheet node sees when a tool pushes it is the membrane
-//! stiffness of the layer under it, not the through-thickness stiffness of its column. The
-//! default is that membrane stiffness shared out by tributary area:
+//! closes slowly. The scale is the membrane stiffness of the layer under the node, shared
+//! out by tributary area:
 //!
 //! ```text
-//! r_a = E * sum over contact faces f at a of  (A_{a,f} / A_f) h_f,   h_f = V_e / A_f
+//! k_a = E * sum over contact faces f at a of  (A_{a,f} / A_f) h_f,   h_f = V_e / A_f
 //! ```
 //!
 //! with `E` Young's modulus (from the elastic tangent), `A_{a,f} = A_f / 4` the node's share
 //! of face f and `h_f` the height of the face's element normal to it (element volume over
-//! face area). An interior node of a sheet of one layer of thickness t gets `E t` (the value
-//! the square cup script used to pick by hand), an edge node `E t / 2`, a corner `E t / 4`;
-//! a node on a block of cubes of side h gets `E h`. Measured on the square cup, the former
-//! default, the column stiffness `M A / h` (M the P-wave modulus), was about 20 times E t on
-//! 3 x 3 x 0.81 mm cells and made the active-set search oscillate (BENCHMARKS.md, issue 14).
-//! A candidate on no contact face (a lone node) gets `E V_e^(1/3)` from its elements.
-//! Cost O(elements).
+//! face area): `E t` at an interior node of a sheet of one layer of thickness t, half at
+//! an edge node, a quarter at a corner, `E h` on a block of cubes of side h. A candidate on
+//! no contact face (a lone node) gets `E V_e^(1/3)` from its elements. Cost O(elements).
+//!
+//! Under the augmented Lagrangian the default r is a tenth of it, `MEMBRANE_FRACTION k_a`
+//! (`0.1 E h` on a block of cubes: GetFEM's customary choice). Under penalty, where r is
+//! the penalty stiffness and sets the penetration `p / r`, it is `k_a` itself. Why a tenth: a tool pressing a sheet is resisted
+//! by the sheet's bending more than by its membrane, and the barely touching nodes of a
+//! sheet wrapping a radius flip with gaps of `lambda / r`. Measured (BENCHMARKS.md, "Default
+//! r a tenth of the membrane stiffness"): the U-channel (tests/scenes) is cut back 8 and 7
+//! times instead of 30 and 34, the 25 x 25 x 1 cups take 304 and 436 Newton iterations
+//! instead of 432 and 522 with no cutback, at the same converged answers. The former
+//! default before this one, the column stiffness `M A / h` (M the P-wave modulus), was
+//! about 200 times the present one on the cup's cells and made the active-set search
+//! oscillate (BENCHMARKS.md, issue 14).
 
 use crate::element::{Element, Hex8};
 use crate::material::Tangent;
@@ -38,8 +45,14 @@ pub fn young_modulus(c: &Tangent) -> f64 {
     mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu)
 }
 
-/// r per candidate (same order as `candidates`), for Young's modulus `young`.
-pub fn default_r(mesh: &Mesh, young: f64, candidates: &[usize]) -> Result<Vec<f64>> {
+/// The fraction of the membrane stiffness under a node that is its default r under the
+/// augmented Lagrangian (module doc).
+pub const MEMBRANE_FRACTION: f64 = 0.1;
+
+/// The membrane stiffness `k_a` per candidate (same order as `candidates`), for Young's
+/// modulus `young`: the default penalty stiffness, and `1 / MEMBRANE_FRACTION` times the
+/// default augmentation parameter.
+pub fn membrane_stiffness(mesh: &Mesh, young: f64, candidates: &[usize]) -> Result<Vec<f64>> {
     let key = |f: &[usize; 4]| {
         let mut k = *f;
         k.sort_unstable();
@@ -85,7 +98,7 @@ mod tests {
         // Cubes of side 0.5: E h at interior face nodes, E h / 2 at edges, E h / 4 at corners.
         let mesh = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 2.0, 1.0), [4, 4, 2]).unwrap();
         let top = mesh.node_set("z+").unwrap().to_vec();
-        let r = default_r(&mesh, 10.0, &top).unwrap();
+        let r = membrane_stiffness(&mesh, 10.0, &top).unwrap();
         let at = |x: f64, y: f64| {
             let k = top
                 .iter()
@@ -98,14 +111,14 @@ mod tests {
         assert!((at(0.0, 1.0) - 2.5).abs() < 1e-12);
         assert!((at(0.0, 0.0) - 1.25).abs() < 1e-12);
         // A sheet of one layer 0.1 thick on 0.5 x 0.5 cells: E t at interior nodes whatever
-        // the cell size (the square cup's hand-picked value).
+        // the cell size.
         let thin = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 2.0, 0.1), [4, 4, 1]).unwrap();
         let top = thin.node_set("z+").unwrap().to_vec();
-        let r = default_r(&thin, 10.0, &top).unwrap();
+        let r = membrane_stiffness(&thin, 10.0, &top).unwrap();
         let max = r.iter().cloned().fold(0.0, f64::max);
         assert!((max - 1.0).abs() < 1e-12, "{max}");
         // A lone node: E times the cube root of its element's volume.
-        let r = default_r(&mesh, 10.0, &[0]).unwrap();
+        let r = membrane_stiffness(&mesh, 10.0, &[0]).unwrap();
         assert!((r[0] - 10.0 * 0.125f64.cbrt()).abs() < 1e-12);
     }
 

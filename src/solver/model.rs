@@ -42,6 +42,9 @@ pub struct ToolContact {
     pub areas: Vec<f64>,
     /// Augmentation (or penalty) parameter r per candidate node, force/length.
     pub r: Vec<f64>,
+    /// Whether `r` is the engine's default (the membrane stiffness under each node until the
+    /// simulation starts, see `augmentation`), not the user's value.
+    pub r_default: bool,
 }
 
 /// Status-prediction re-solves per Newton step by default: 8. They take 42-50 % fewer
@@ -247,10 +250,12 @@ impl Model {
         }
         let candidates = self.nodes(set)?;
         let areas = self.mesh.tributary_areas(&candidates)?;
+        let r_default = r.is_none();
         let r = match r {
             Some(r) => vec![r; candidates.len()],
-            // The membrane stiffness of the layer under each node (see `augmentation`).
-            None => super::augmentation::default_r(
+            // The membrane stiffness of the layer under each node, scaled to the enforcement
+            // when the simulation starts (`settle_default_r`; the settings may still change).
+            None => super::augmentation::membrane_stiffness(
                 &self.mesh,
                 super::augmentation::young_modulus(&self.material.elastic_tangent()),
                 &candidates,
@@ -261,8 +266,24 @@ impl Model {
             candidates,
             areas,
             r,
+            r_default,
         });
         Ok(())
+    }
+
+    /// Turns the default r of every tool (the membrane stiffness under each node, see
+    /// `augmentation`) into the value for the enforcement in the settings: a tenth of it
+    /// (`MEMBRANE_FRACTION`) under the augmented Lagrangian, itself under penalty. Called
+    /// once, when the simulation starts; a value the user gave is kept.
+    pub fn settle_default_r(&mut self) {
+        if self.settings.contact.enforcement != crate::contact::Enforcement::AugmentedLagrangian {
+            return;
+        }
+        for c in self.contacts.iter_mut().filter(|c| c.r_default) {
+            c.r.iter_mut()
+                .for_each(|r| *r *= super::augmentation::MEMBRANE_FRACTION);
+            c.r_default = false;
+        }
     }
 
     /// Nodal external forces at time `t` (3 per node): every load's total spread by its

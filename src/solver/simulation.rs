@@ -117,8 +117,9 @@ pub struct Simulation {
 
 impl Simulation {
     /// Sets up unknowns and initial history. Fails on an invalid model.
-    pub fn new(model: Model) -> Result<Self> {
+    pub fn new(mut model: Model) -> Result<Self> {
         model.mesh.validate()?;
+        model.settle_default_r();
         if model.settings.increments == 0 {
             return Err(Error::input("number of increments", 0, "must be >= 1"));
         }
