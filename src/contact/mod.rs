@@ -39,6 +39,9 @@ pub struct ContactSettings {
     pub curvature: bool,
     /// Explicit (paper) or implicit (trapezoidal, in the Newton loop) friction update.
     pub friction_update: FrictionUpdate,
+    /// The default augmentation parameter under the augmented Lagrangian as a fraction of
+    /// the membrane stiffness under each node (`solver::augmentation`).
+    pub r_fraction: f64,
 }
 
 impl Default for ContactSettings {
@@ -48,6 +51,7 @@ impl Default for ContactSettings {
             frame: FrameUpdate::EveryIteration,
             curvature: true,
             friction_update: FrictionUpdate::Explicit,
+            r_fraction: crate::solver::augmentation::MEMBRANE_FRACTION,
         }
     }
 }

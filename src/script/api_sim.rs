@@ -731,6 +731,7 @@ pub const SETTING_KEYS: &[&str] = &[
     "curvature",
     "frame",
     "enforcement",
+    "r_fraction",
     "friction_update",
     "eliminate_multipliers",
     "linear_solver",
@@ -796,6 +797,13 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             "status_prediction" => s.status_prediction = count(key)?,
             "rollback_depth" => step.rollback_depth = count(key)?,
             "last_resort" => step.last_resort = flag(v, key)?,
+            "r_fraction" => {
+                let f = num(key)?;
+                if !(f > 0.0 && f.is_finite()) {
+                    return fail(Error::input(key, f, "must be > 0"));
+                }
+                s.contact.r_fraction = f;
+            }
             "checkpoint_every" => st.checkpoint_every = count(key)?,
             "increments" => {
                 let n = number(v, key)?;

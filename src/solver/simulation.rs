@@ -119,6 +119,10 @@ impl Simulation {
     /// Sets up unknowns and initial history. Fails on an invalid model.
     pub fn new(mut model: Model) -> Result<Self> {
         model.mesh.validate()?;
+        let fraction = model.settings.contact.r_fraction;
+        if !(fraction > 0.0 && fraction.is_finite()) {
+            return Err(Error::input("r_fraction", fraction, "must be > 0"));
+        }
         model.settle_default_r();
         if model.settings.increments == 0 {
             return Err(Error::input("number of increments", 0, "must be >= 1"));
