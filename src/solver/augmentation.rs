@@ -19,17 +19,18 @@
 //! an edge node, a quarter at a corner, `E h` on a block of cubes of side h. A candidate on
 //! no contact face (a lone node) gets `E V_e^(1/3)` from its elements. Cost O(elements).
 //!
-//! Under the augmented Lagrangian the default r is a tenth of it, `MEMBRANE_FRACTION k_a`
-//! (`0.1 E h` on a block of cubes: GetFEM's customary choice). Under penalty, where r is
-//! the penalty stiffness and sets the penetration `p / r`, it is `k_a` itself. Why a tenth: a tool pressing a sheet is resisted
+//! Under the augmented Lagrangian the default r is a fraction of it, the setting
+//! `r_fraction` (`MEMBRANE_FRACTION`, a tenth, by default; `0.1 E h` on a block of cubes is
+//! GetFEM's customary choice); under penalty, where r is the penalty stiffness and sets the
+//! penetration `p / r`, it is `k_a` itself. Why a tenth: a tool pressing a sheet is resisted
 //! by the sheet's bending more than by its membrane, and the barely touching nodes of a
-//! sheet wrapping a radius flip with gaps of `lambda / r`. Measured (BENCHMARKS.md, "Default
-//! r a tenth of the membrane stiffness"): the U-channel (tests/scenes) is cut back 8 and 7
-//! times instead of 30 and 34, the 25 x 25 x 1 cups take 304 and 436 Newton iterations
-//! instead of 432 and 522 with no cutback, at the same converged answers. The former
-//! default before this one, the column stiffness `M A / h` (M the P-wave modulus), was
-//! about 200 times the present one on the cup's cells and made the active-set search
-//! oscillate (BENCHMARKS.md, issue 14).
+//! sheet wrapping a radius flip their status on gaps of `lambda / r`. Measured
+//! (BENCHMARKS.md, "Default r a tenth of the membrane stiffness"): the U-channel
+//! (tests/scenes) is cut back 8 and 7 times instead of 30 and 34, the 25 x 25 x 1 cups take
+//! 304 and 436 Newton iterations instead of 432 and 522 with no cutback, at the same
+//! converged answers. The first default, the column stiffness `M A / h` (M the P-wave
+//! modulus), was about 200 times the present one on the cup's cells and made the
+//! active-set search oscillate (BENCHMARKS.md, issue 14).
 
 use crate::element::{Element, Hex8};
 use crate::material::Tangent;
