@@ -133,3 +133,50 @@ fn frozen_frame_on_a_cylinder_leaves_a_gap_error_of_the_order_of_the_curvature()
         "one symbolic analysis for the whole run"
     );
 }
+
+/// The default r of a tool added without one: a tenth (`r_fraction`) of the membrane
+/// stiffness under each node under the augmented Lagrangian, the membrane stiffness itself
+/// under penalty (where r sets the penetration), another fraction when the setting asks;
+/// a value the user gave is kept whatever the enforcement. The block's cubes have side
+/// 2.5 x 2.5 x 1 (4 x 4 x 2 cells of 10 x 10 x 2): membrane stiffness E h = 1000 at
+/// interior face nodes of its bottom (h = 1), half on edges, a quarter at corners.
+#[test]
+fn default_r_is_a_fraction_of_the_membrane_stiffness_under_the_augmented_lagrangian() {
+    let with = |enforcement: Enforcement, fraction: Option<f64>, r: Option<f64>| -> Vec<f64> {
+        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(10.0, 10.0, 2.0), [4, 4, 2]).unwrap();
+        let mut model = Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
+        let plane = Plane::new(Vec3::zeros(), Vec3::z()).unwrap();
+        model
+            .add_tool(
+                common::tool("floor", plane, &[(0.0, [0.0; 3])], MU),
+                "z-",
+                r,
+            )
+            .unwrap();
+        model.settings.contact.enforcement = enforcement;
+        if let Some(f) = fraction {
+            model.settings.contact.r_fraction = f;
+        }
+        Simulation::new(model).unwrap().model.contacts[0].r.clone()
+    };
+    let largest = |r: &[f64]| r.iter().cloned().fold(0.0, f64::max);
+    let smallest = |r: &[f64]| r.iter().cloned().fold(f64::INFINITY, f64::min);
+    let al = with(Enforcement::AugmentedLagrangian, None, None);
+    assert!((largest(&al) - 100.0).abs() < 1e-9, "{al:?}");
+    assert!((smallest(&al) - 25.0).abs() < 1e-9, "{al:?}");
+    let penalty = with(Enforcement::Penalty, None, None);
+    assert!((largest(&penalty) - 1000.0).abs() < 1e-9, "{penalty:?}");
+    let half = with(Enforcement::AugmentedLagrangian, Some(0.5), None);
+    assert!((largest(&half) - 500.0).abs() < 1e-9, "{half:?}");
+    for enforcement in [Enforcement::AugmentedLagrangian, Enforcement::Penalty] {
+        let given = with(enforcement, Some(0.5), Some(7.0));
+        assert!(given.iter().all(|&r| r == 7.0), "{given:?}");
+    }
+    let mesh = Mesh::block(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [1, 1, 1]).unwrap();
+    let mut model = Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
+    model.settings.contact.r_fraction = 0.0;
+    let err = Simulation::new(model)
+        .err()
+        .expect("r_fraction 0 is refused");
+    assert!(err.to_string().contains("r_fraction"), "{err}");
+}

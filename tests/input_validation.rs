@@ -98,6 +98,8 @@ fn counts_are_refused_with_the_given_value() {
             "max_iterations: 2.5",
             "max_iterations = 2.5 must be a whole number >= 0",
         ),
+        ("r_fraction: -0.1", "r_fraction = -0.1 must be > 0"),
+        ("r_fraction: 0.0", "r_fraction = 0 must be > 0"),
     ] {
         let src = format!("{SCENE}sim.settings(#{{ {setting} }});\n");
         let (code, err) = run("counts", &src, &[]);
