@@ -61,7 +61,7 @@ fn the_guard_ends_attempts_gone_astray_on_the_u_channel() {
         "the scene's layout"
     );
     let source = format!(
-        "{}let r = u_channel(0.0, 3.0, 6);\nprint(`cutbacks ${{r.cutbacks}}`);\n",
+        "{}let r = u_channel(0.0, 3.0, 6, false);\nprint(`cutbacks ${{r.cutbacks}}`);\n",
         scene[..scene.find(driver).unwrap()]
             .replace(marker, "kinematics: \"finite\", r_fraction: 1.0 });")
     );
