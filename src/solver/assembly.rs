@@ -133,13 +133,14 @@ pub(super) fn worker_threads(setting: usize) -> usize {
 }
 
 /// Element forces and stiffnesses of one evaluation, element after element: `force[24 e..]`
-/// and `stiffness[576 e..]` (column-major), the latter empty for a residual-only
-/// evaluation.
-struct ElementBuffers {
+/// and `stiffness[576 e..]` (column-major; a residual-only evaluation leaves it as it
+/// was). Kept between the evaluations of an increment
+/// ([`IncrementContext::element_buffers`]): every element overwrites its own entries, so
+/// the buffers are sized, never cleared.
+#[derive(Debug, Default)]
+pub struct ElementBuffers {
     force: Vec<f64>,
     stiffness: Vec<f64>,
-    /// Elements whose call stopped their local solve early ([`LocalSolve::Approximate`]).
-    approximate: usize,
 }
 
 /// What the elements remember between the evaluations of one Newton attempt
@@ -166,9 +167,12 @@ impl ElementMemory {
 
 /// Evaluates every element at the unknowns `x`, on `threads` threads over contiguous
 /// blocks of elements, writing the trial states of their integration points and each
-/// element's force (and, with `tangent`, stiffness) straight into its place in the
-/// returned buffers, so that the assembly (and hence every result) is the same whatever
-/// the thread count. The first failing element in element order is the one reported.
+/// element's force (and, with `tangent`, stiffness) straight into its place in
+/// `buffers`, so that the assembly (and hence every result) is the same whatever the
+/// thread count. Returns the number of elements whose call stopped their local solve
+/// early ([`LocalSolve::Approximate`]). The first failing element in element order is the
+/// one reported.
+#[allow(clippy::too_many_arguments)]
 fn evaluate_elements(
     model: &Model,
     x: &[f64],
@@ -177,7 +181,8 @@ fn evaluate_elements(
     threads: usize,
     tangent: bool,
     memory: &ElementMemory,
-) -> Result<ElementBuffers> {
+    buffers: &mut ElementBuffers,
+) -> Result<usize> {
     const D: usize = crate::element::hex8::DOFS;
     let element = model.element()?;
     let per_elem = element.point_count();
@@ -194,10 +199,13 @@ fn evaluate_elements(
         model.material.as_ref(),
     );
     let n_elem = hexes.len();
-    let mut buffers = ElementBuffers {
-        force: vec![0.0; n_elem * D],
-        stiffness: vec![0.0; if tangent { n_elem * D * D } else { 0 }],
-        approximate: 0,
+    buffers.force.resize(n_elem * D, 0.0);
+    let force = &mut buffers.force[..];
+    let stiffness: &mut [f64] = if tangent {
+        buffers.stiffness.resize(n_elem * D * D, 0.0);
+        &mut buffers.stiffness
+    } else {
+        &mut []
     };
     let evaluate_block = |first: usize,
                           trial: &mut [PointState],
@@ -248,13 +256,7 @@ fn evaluate_elements(
     // Below a few dozen elements, starting threads costs more than it saves.
     const MIN_PARALLEL_ELEMENTS: usize = 64;
     let outcome = if threads <= 1 || n_elem < MIN_PARALLEL_ELEMENTS {
-        evaluate_block(
-            0,
-            trial,
-            &mut buffers.force,
-            &mut buffers.stiffness,
-            &mut memory,
-        )
+        evaluate_block(0, trial, force, stiffness, &mut memory)
     } else {
         evaluate_on_threads(
             n_elem,
@@ -263,7 +265,8 @@ fn evaluate_elements(
             remembers,
             tangent,
             trial,
-            &mut buffers,
+            force,
+            stiffness,
             &mut memory,
             &evaluate_block,
         )
@@ -271,8 +274,7 @@ fn evaluate_elements(
     if let (Err(_), Some(before)) = (&outcome, before) {
         *memory = before;
     }
-    buffers.approximate = outcome?;
-    Ok(buffers)
+    outcome
 }
 
 /// The element loop of [`evaluate_elements`] on `threads` threads, over contiguous blocks
@@ -285,7 +287,8 @@ fn evaluate_on_threads<F>(
     remembers: usize,
     tangent: bool,
     trial: &mut [PointState],
-    buffers: &mut ElementBuffers,
+    force: &mut [f64],
+    stiffness: &mut [f64],
     memory: &mut [f64],
     evaluate_block: &F,
 ) -> Result<usize>
@@ -295,8 +298,7 @@ where
     const D: usize = crate::element::hex8::DOFS;
     let block = n_elem.div_ceil(threads);
     let stiffness_block = if tangent { block * D * D } else { 1 };
-    let mut stiffness_chunks: Vec<&mut [f64]> =
-        buffers.stiffness.chunks_mut(stiffness_block).collect();
+    let mut stiffness_chunks: Vec<&mut [f64]> = stiffness.chunks_mut(stiffness_block).collect();
     stiffness_chunks.resize_with(n_elem.div_ceil(block), Default::default);
     let mut memory_chunks: Vec<&mut [f64]> = if remembers == 0 {
         Vec::new()
@@ -307,7 +309,7 @@ where
     let results: Vec<Result<usize>> = std::thread::scope(|scope| {
         let handles: Vec<_> = trial
             .chunks_mut(block * per_elem)
-            .zip(buffers.force.chunks_mut(block * D))
+            .zip(force.chunks_mut(block * D))
             .zip(stiffness_chunks)
             .zip(memory_chunks)
             .enumerate()
@@ -418,6 +420,8 @@ pub struct IncrementContext<'a> {
     /// Whether full evaluations keep their element stiffness (status prediction re-solves
     /// with other contact statuses at the same unknowns).
     pub keep_element_jacobian: bool,
+    /// The element loop's output, reused by every evaluation.
+    pub element_buffers: std::sync::Mutex<ElementBuffers>,
 }
 
 /// What the elements give at some unknowns: the part of an evaluation that does not depend
@@ -468,7 +472,8 @@ impl IncrementContext<'_> {
         let threads = worker_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);
         let mut trial_points = self.committed_points.to_vec();
-        let elements = evaluate_elements(
+        let mut elements = self.element_buffers();
+        evaluate_elements(
             model,
             x,
             self.committed_points,
@@ -476,6 +481,7 @@ impl IncrementContext<'_> {
             threads,
             true,
             &self.element_memory,
+            &mut elements,
         )?;
         let mut jac = SparseMatrix::zeros(self.pattern.clone());
         slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
@@ -567,6 +573,12 @@ impl IncrementContext<'_> {
         self.with_contact(x, part, times, true, Some(eval))
     }
 
+    fn element_buffers(&self) -> std::sync::MutexGuard<'_, ElementBuffers> {
+        self.element_buffers
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+    }
+
     /// The multiplier components `k` of a pair whose equation becomes `lambda_k = 0`: a
     /// sticking candidate `node` with a prescribed displacement component `k` (see
     /// `evaluate_with`).
@@ -645,7 +657,8 @@ impl IncrementContext<'_> {
         let t0 = Instant::now();
         let threads = worker_threads(model.settings.threads);
         let slots = self.dofs.slots(model, &self.pattern);
-        let elements = evaluate_elements(
+        let mut elements = self.element_buffers();
+        let approximate = evaluate_elements(
             model,
             x,
             self.committed_points,
@@ -653,6 +666,7 @@ impl IncrementContext<'_> {
             threads,
             with_jacobian,
             &self.element_memory,
+            &mut elements,
         )?;
         for (hex, force) in model.mesh.hexes.iter().zip(elements.force.chunks(24)) {
             for (a, &na) in hex.iter().enumerate() {
@@ -665,12 +679,12 @@ impl IncrementContext<'_> {
             slots.gather_elements(&elements.stiffness, &mut jac.values, threads);
         }
         times.elements += t0.elapsed().as_secs_f64();
-        times.approximate_evaluations += usize::from(elements.approximate > 0);
+        times.approximate_evaluations += usize::from(approximate > 0);
         Ok(ElementPart {
             jacobian: jac,
             f_int,
             trial_points,
-            approximate_elements: elements.approximate,
+            approximate_elements: approximate,
         })
     }
 
@@ -1021,6 +1035,7 @@ mod tests {
                 forced: None,
                 element_memory: Default::default(),
                 keep_element_jacobian: true,
+                element_buffers: Default::default(),
             };
             let mut times = PhaseTimes::default();
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();

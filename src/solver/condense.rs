@@ -58,12 +58,24 @@ use crate::Result;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-/// A reduced matrix's values with the Jacobian values and coefficients it was built from.
+/// The last reduced system with the Jacobian values and coefficients it was built from,
+/// kept between calls: the next call replays only what changed into it
+/// ([`Condenser::reduce`]) and the linear solver works on it in place. Its buffers are
+/// reused from call to call.
 #[derive(Debug)]
-struct LastReduction {
+struct Reduction {
+    /// The Jacobian values it was built from (empty before the first call).
     jacobian: Vec<f64>,
     coefficients: Vec<f64>,
-    values: Vec<f64>,
+    /// The coefficients of the call under way, until they are compared with
+    /// `coefficients` and swapped with them.
+    fresh_coefficients: Vec<f64>,
+    matrix: SparseMatrix,
+    rhs: Vec<f64>,
+    /// [`Condenser::mark_dirty`]'s flags: per full row, per eliminated node, per segment.
+    row_changed: Vec<bool>,
+    node_changed: Vec<bool>,
+    dirty: Vec<bool>,
 }
 
 /// Elimination groups of the mixed unknowns (see `SparsePattern::groups`): a node's
@@ -155,8 +167,8 @@ pub struct Condenser {
     /// the kept rows in `kept_rows`' order, then the eliminated nodes.
     segment_start: Vec<usize>,
     kept_rows: Vec<usize>,
-    /// The last reduced matrix and what it was built from, for [`Self::reduced_with`].
-    last: Mutex<Option<LastReduction>>,
+    /// The last reduced system and what it was built from, for [`Self::reduce`].
+    last: Mutex<Reduction>,
     /// The back-substitution's `N du` terms, (column, value position) of every kept column
     /// of each eliminated node's local rows, node after node and row after row (the
     /// entries of `rows` that are not eliminated multipliers, listed once instead of
@@ -309,6 +321,16 @@ impl Condenser {
         if pattern.nnz() > u32::MAX as usize {
             return None;
         }
+        let last = Reduction {
+            jacobian: Vec::new(),
+            coefficients: Vec::new(),
+            fresh_coefficients: Vec::new(),
+            matrix: SparseMatrix::zeros(pattern.clone()),
+            rhs: Vec::new(),
+            row_changed: Vec::new(),
+            node_changed: Vec::new(),
+            dirty: Vec::new(),
+        };
         let mut condenser = Condenser {
             nodes,
             coefficient_count,
@@ -321,7 +343,7 @@ impl Condenser {
             reduced_len: Vec::new(),
             segment_start: Vec::new(),
             kept_rows: Vec::new(),
-            last: Mutex::new(None),
+            last: Mutex::new(last),
             back_terms: Vec::new(),
             back_ptr: vec![0],
             fallbacks: AtomicUsize::new(0),
@@ -346,8 +368,9 @@ impl Condenser {
             .collect();
         // Record the plan: the walk only depends on the pattern, so zero values will do.
         let zeros = vec![0.0; full.nnz()];
-        let coefficients = condenser
-            .coefficients(&zeros)
+        let mut coefficients = Vec::new();
+        condenser
+            .coefficients(&zeros, &mut coefficients)
             .expect("with a zero Jacobian every pair is in gap");
         let mut rhs = vec![0.0; next];
         let mut plan = Recorder {
@@ -392,27 +415,31 @@ impl Condenser {
         &self.pattern
     }
 
-    /// Every node's coefficient matrix `C = [P; H]` (module doc) from the Jacobian values:
-    /// rows 0..3 combine the local rows into the condensed rows, row `3 + 3p + beta`
-    /// recovers pair p's multiplier component beta. O(m^2) per node.
-    fn coefficients(&self, j: &[f64]) -> std::result::Result<Vec<f64>, NoLocalElimination> {
-        let mut out = vec![0.0; self.coefficient_count];
+    /// Every node's coefficient matrix `C = [P; H]` (module doc) from the Jacobian values,
+    /// into `out`: rows 0..3 combine the local rows into the condensed rows, row
+    /// `3 + 3p + beta` recovers pair p's multiplier component beta. O(m^2) per node.
+    fn coefficients(
+        &self,
+        j: &[f64],
+        out: &mut Vec<f64>,
+    ) -> std::result::Result<(), NoLocalElimination> {
+        out.clear();
+        out.resize(self.coefficient_count, 0.0);
+        let (mut m, mut dets) = (Vec::new(), Vec::new());
         for e in &self.nodes {
             let w = e.width();
             let c = &mut out[e.offset..e.offset + w * w];
-            let m: Vec<[[f64; 3]; 3]> = e
-                .pairs
-                .iter()
-                .map(|p| {
-                    std::array::from_fn(|a| {
-                        std::array::from_fn(|b| {
-                            let e_l = p.e_l_position[a][b].map_or(0.0, |k| j[k]);
-                            f64::from(u8::from(a == b)) - e_l
-                        })
+            m.clear();
+            m.extend(e.pairs.iter().map(|p| -> [[f64; 3]; 3] {
+                std::array::from_fn(|a| {
+                    std::array::from_fn(|b| {
+                        let e_l = p.e_l_position[a][b].map_or(0.0, |k| j[k]);
+                        f64::from(u8::from(a == b)) - e_l
                     })
                 })
-                .collect();
-            let dets: Vec<f64> = m.iter().map(|mp| det3(mp).abs()).collect();
+            }));
+            dets.clear();
+            dets.extend(m.iter().map(|mp| det3(mp).abs()));
             let q = (0..m.len())
                 .min_by(|&a, &b| dets[a].total_cmp(&dets[b]))
                 .expect("an eliminated node has a pair");
@@ -453,7 +480,7 @@ impl Condenser {
                 }
             }
         }
-        Ok(out)
+        Ok(())
     }
 
     /// Adds `factor` times the reduced columns of node `e`'s local row `i` to reduced row
@@ -551,93 +578,85 @@ impl Condenser {
         j: &SparseMatrix,
         residual: &[f64],
     ) -> Option<(SparseMatrix, Vec<f64>)> {
-        let coefficients = self.coefficients(&j.values).ok()?;
-        Some(self.reduced_with(&coefficients, j, residual))
+        let mut kept = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        self.coefficients(&j.values, &mut kept.fresh_coefficients)
+            .ok()?;
+        self.reduce(&mut kept, j, residual);
+        Some((kept.matrix.clone(), kept.rhs.clone()))
     }
 
-    fn reduced_with(
-        &self,
-        coefficients: &[f64],
-        j: &SparseMatrix,
-        residual: &[f64],
-    ) -> (SparseMatrix, Vec<f64>) {
-        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
-        let dirty = last
-            .as_ref()
-            .filter(|l| l.jacobian.len() == j.values.len())
-            .map(|l| self.dirty_segments(l, j, coefficients));
-        // Starting from the last reduction's values (copied, not zeroed and then copied).
-        let mut a = match (&dirty, last.as_ref()) {
-            (Some(_), Some(kept)) => SparseMatrix {
-                pattern: self.pattern.clone(),
-                values: kept.values.clone(),
-            },
-            _ => SparseMatrix::zeros(self.pattern.clone()),
-        };
-        let mut rhs = vec![0.0; self.pattern.n];
+    /// Brings `kept` to the reduced system of `j` and `residual`, with the coefficients of
+    /// `j` in `kept.fresh_coefficients` ([`Self::reduced_system`]): from the last reduction's
+    /// values, replaying the dirty segments only, or, on the first call, every segment into
+    /// zeros.
+    fn reduce(&self, kept: &mut Reduction, j: &SparseMatrix, residual: &[f64]) {
+        std::mem::swap(&mut kept.coefficients, &mut kept.fresh_coefficients);
+        let partial = kept.jacobian.len() == j.values.len();
+        if partial {
+            self.mark_dirty(kept, j);
+        } else {
+            kept.jacobian.clone_from(&j.values);
+            kept.matrix.values.fill(0.0);
+        }
+        kept.rhs.clear();
+        kept.rhs.resize(self.pattern.n, 0.0);
         let mut replay = Replay {
             slots: &self.slots,
             segment_start: &self.segment_start,
-            dirty: dirty.as_deref(),
+            dirty: partial.then_some(&kept.dirty[..]),
             active: true,
             next: 0,
-            values: &mut a.values,
+            values: &mut kept.matrix.values,
         };
-        self.walk(coefficients, &j.values, residual, &mut rhs, &mut replay);
-        let kept = last.get_or_insert_with(|| LastReduction {
-            jacobian: Vec::new(),
-            coefficients: Vec::new(),
-            values: Vec::new(),
-        });
-        let keep = |to: &mut Vec<f64>, from: &[f64]| {
-            to.clear();
-            to.extend_from_slice(from);
-        };
-        keep(&mut kept.jacobian, &j.values);
-        keep(&mut kept.coefficients, coefficients);
-        keep(&mut kept.values, &a.values);
-        (a, rhs)
+        self.walk(
+            &kept.coefficients,
+            &j.values,
+            residual,
+            &mut kept.rhs,
+            &mut replay,
+        );
     }
 
-    /// The segments of the walk whose contributions differ from those of `last`: an
-    /// eliminated node whose coefficients or local rows changed, a kept row that changed or
-    /// has a column of such a node. Values are compared bit for bit.
-    fn dirty_segments(
-        &self,
-        last: &LastReduction,
-        j: &SparseMatrix,
-        coefficients: &[f64],
-    ) -> Vec<bool> {
+    /// Sets `kept.dirty` to the segments of the walk whose contributions differ from those
+    /// of the kept reduction: an eliminated node whose coefficients (`kept.coefficients`
+    /// against the previous ones, now in `kept.fresh_coefficients`) or local rows changed,
+    /// a kept row that changed or has a column of such a node. Values are compared bit for
+    /// bit, and the changed Jacobian values copied into `kept.jacobian` in the same pass.
+    fn mark_dirty(&self, kept: &mut Reduction, j: &SparseMatrix) {
         let n = self.rows.len();
-        let mut row_changed = vec![false; n];
-        for (k, (new, old)) in j.values.iter().zip(&last.jacobian).enumerate() {
+        let row_changed = &mut kept.row_changed;
+        row_changed.clear();
+        row_changed.resize(n, false);
+        for (k, (&new, old)) in j.values.iter().zip(&mut kept.jacobian).enumerate() {
             if new.to_bits() != old.to_bits() {
                 row_changed[j.pattern.row_idx[k]] = true;
+                *old = new;
             }
         }
-        let node_changed: Vec<bool> = self
-            .nodes
-            .iter()
-            .map(|e| {
-                let w = e.width();
-                let range = e.offset..e.offset + w * w;
-                (0..w).any(|i| row_changed[e.local_row(i)])
-                    || coefficients[range.clone()]
-                        .iter()
-                        .zip(&last.coefficients[range])
-                        .any(|(a, b)| a.to_bits() != b.to_bits())
-            })
-            .collect();
-        self.kept_rows
-            .iter()
-            .map(|&row| {
-                row_changed[row]
-                    || self.rows[row]
-                        .iter()
-                        .any(|&(col, _)| self.owner[col].is_some_and(|(e, _)| node_changed[e]))
-            })
-            .chain(node_changed.iter().copied())
-            .collect()
+        let (coefficients, previous) = (&kept.coefficients, &kept.fresh_coefficients);
+        kept.node_changed.clear();
+        kept.node_changed.extend(self.nodes.iter().map(|e| {
+            let w = e.width();
+            let range = e.offset..e.offset + w * w;
+            (0..w).any(|i| row_changed[e.local_row(i)])
+                || coefficients[range.clone()]
+                    .iter()
+                    .zip(&previous[range])
+                    .any(|(a, b)| a.to_bits() != b.to_bits())
+        }));
+        let node_changed = &kept.node_changed;
+        kept.dirty.clear();
+        kept.dirty.extend(
+            self.kept_rows
+                .iter()
+                .map(|&row| {
+                    row_changed[row]
+                        || self.rows[row]
+                            .iter()
+                            .any(|&(col, _)| self.owner[col].is_some_and(|(e, _)| node_changed[e]))
+                })
+                .chain(node_changed.iter().copied()),
+        );
     }
 
     /// The same reduced system with every contribution placed by a binary search in the
@@ -649,7 +668,8 @@ impl Condenser {
         j: &SparseMatrix,
         residual: &[f64],
     ) -> Option<(SparseMatrix, Vec<f64>)> {
-        let coefficients = self.coefficients(&j.values).ok()?;
+        let mut coefficients = Vec::new();
+        self.coefficients(&j.values, &mut coefficients).ok()?;
         let mut a = SparseMatrix::zeros(self.pattern.clone());
         let mut rhs = vec![0.0; self.pattern.n];
         self.walk(
@@ -674,18 +694,24 @@ impl Condenser {
         linear: &mut dyn LinearSolver,
     ) -> Result<Vec<f64>> {
         let n = j.pattern.n;
-        let Ok(coefficients) = self.coefficients(&j.values) else {
+        let mut kept = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        let kept = &mut *kept;
+        if self
+            .coefficients(&j.values, &mut kept.fresh_coefficients)
+            .is_err()
+        {
             self.fallbacks.fetch_add(1, Ordering::Relaxed);
             let mut dx: Vec<f64> = residual.iter().map(|v| -v).collect();
             linear.solve_bordered(j, &mut dx, border)?;
             return Ok(dx);
-        };
-        let (a, mut rhs) = self.reduced_with(&coefficients, j, residual);
+        }
+        self.reduce(kept, j, residual);
         let reduced_border: Vec<usize> = border
             .iter()
             .filter_map(|&d| self.reduced_index[d])
             .collect();
-        linear.solve_bordered(&a, &mut rhs, &reduced_border)?;
+        linear.solve_bordered(&kept.matrix, &mut kept.rhs, &reduced_border)?;
+        let (rhs, coefficients) = (&kept.rhs, &kept.coefficients);
         let mut dx = vec![0.0; n];
         for (d, ri) in self.reduced_index.iter().enumerate() {
             if let Some(ri) = ri {

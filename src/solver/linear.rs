@@ -261,6 +261,11 @@ pub struct SymmetricLu {
     no_fallback: bool,
     /// Threads of the numeric factorization ([`LinearSolver::set_threads`]).
     threads: usize,
+    /// The backward-error check's `A x`, `b - A x` and row sums of `|A|`, kept between
+    /// calls.
+    product: Vec<f64>,
+    residual: Vec<f64>,
+    row_sums: Vec<f64>,
 }
 
 /// See [`SymmetricLu::failures_in_a_row`].
@@ -295,16 +300,28 @@ impl SymmetricLu {
         }
         self.numeric.solve_in_place(symbolic, rhs, nrhs);
         let n = p.n;
-        let norm_a = a.row_abs_sums().into_iter().fold(0.0, f64::max);
+        // |A|_inf, from the row sums taken in the first product's pass over A.
+        let mut norm_a = None;
         for c in 0..nrhs {
             let (x, b) = (&mut rhs[c * n..(c + 1) * n], &original[c * n..(c + 1) * n]);
             let mut refined = false;
             loop {
-                let ax = a.mul_vec(x);
-                let mut r: Vec<f64> = b.iter().zip(&ax).map(|(b, y)| b - y).collect();
+                let norm = match norm_a {
+                    Some(norm) => {
+                        a.mul_vec_into(x, &mut self.product);
+                        norm
+                    }
+                    None => {
+                        a.mul_vec_and_row_abs_sums(x, &mut self.product, &mut self.row_sums);
+                        *norm_a.insert(self.row_sums.iter().copied().fold(0.0, f64::max))
+                    }
+                };
+                let r = &mut self.residual;
+                r.clear();
+                r.extend(b.iter().zip(&self.product).map(|(b, y)| b - y));
                 let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                let scale = norm_a * inf(x) + inf(b);
-                let error = inf(&r);
+                let scale = norm * inf(x) + inf(b);
+                let error = inf(r);
                 if !(error.is_finite() && scale.is_finite()) {
                     return Ok(false);
                 }
@@ -314,8 +331,8 @@ impl SymmetricLu {
                 if refined {
                     return Ok(false);
                 }
-                self.numeric.solve_in_place(symbolic, &mut r, 1);
-                x.iter_mut().zip(&r).for_each(|(x, d)| *x += d);
+                self.numeric.solve_in_place(symbolic, r, 1);
+                x.iter_mut().zip(r.iter()).for_each(|(x, d)| *x += d);
                 refined = true;
             }
         }

@@ -314,6 +314,7 @@ impl Simulation {
             forced: None,
             element_memory: self.committed_memory.clone().into(),
             keep_element_jacobian: self.model.settings.status_prediction > 0,
+            element_buffers: Default::default(),
         }
     }
 

@@ -146,14 +146,38 @@ impl SparseMatrix {
 
     /// y = A x.
     pub fn mul_vec(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = Vec::new();
+        self.mul_vec_into(x, &mut y);
+        y
+    }
+
+    /// y = A x into `y`'s storage.
+    pub fn mul_vec_into(&self, x: &[f64], y: &mut Vec<f64>) {
         let p = &self.pattern;
-        let mut y = vec![0.0; p.n];
+        y.clear();
+        y.resize(p.n, 0.0);
         for c in 0..p.n {
             for k in p.col_ptr[c]..p.col_ptr[c + 1] {
                 y[p.row_idx[k]] += self.values[k] * x[c];
             }
         }
-        y
+    }
+
+    /// [`Self::mul_vec`] and [`Self::row_abs_sums`] into `y` and `sums` in one pass over the
+    /// entries: the same sums, added in the same order.
+    pub fn mul_vec_and_row_abs_sums(&self, x: &[f64], y: &mut Vec<f64>, sums: &mut Vec<f64>) {
+        let p = &self.pattern;
+        y.clear();
+        y.resize(p.n, 0.0);
+        sums.clear();
+        sums.resize(p.n, 0.0);
+        for c in 0..p.n {
+            for k in p.col_ptr[c]..p.col_ptr[c + 1] {
+                let (r, v) = (p.row_idx[k], self.values[k]);
+                y[r] += v * x[c];
+                sums[r] += v.abs();
+            }
+        }
     }
 }
 

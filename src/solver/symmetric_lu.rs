@@ -93,8 +93,10 @@ pub struct SymbolicSymmetricLu {
     /// Descendant updates of supernode s: `updates[update_ptr[s]..update_ptr[s + 1]]`.
     update_ptr: Vec<usize>,
     updates: Vec<Update>,
-    /// Value index of every entry of `A` (in `A`'s storage order).
-    slot: Vec<usize>,
+    /// The entries of `A` that supernode s's panels hold, as (index in `A`'s values,
+    /// value index): `gather[gather_ptr[s]..gather_ptr[s + 1]]`.
+    gather_ptr: Vec<usize>,
+    gather: Vec<(usize, usize)>,
     /// Supernode whose panels hold each entry of `A` (in `A`'s storage order).
     entry_super: Vec<usize>,
     /// Floating-point operations of each supernode's numeric step (its descendant updates,
@@ -225,7 +227,8 @@ impl SymbolicSymmetricLu {
             offset,
             update_ptr,
             updates,
-            slot: Vec::new(),
+            gather_ptr: Vec::new(),
+            gather: Vec::new(),
             entry_super: Vec::new(),
             flops: Vec::new(),
             total_flops: 0.0,
@@ -272,7 +275,22 @@ impl SymbolicSymmetricLu {
                 })?);
             }
         }
-        analysis.slot = slot;
+        // Counting sort of the entries by supernode.
+        let mut gather_ptr = vec![0; ns + 1];
+        for &s in &entry_super {
+            gather_ptr[s + 1] += 1;
+        }
+        for s in 0..ns {
+            gather_ptr[s + 1] += gather_ptr[s];
+        }
+        let mut next = gather_ptr.clone();
+        let mut gather = vec![(0, 0); slot.len()];
+        for (i, (&k, &s)) in slot.iter().zip(&entry_super).enumerate() {
+            gather[next[s]] = (i, k);
+            next[s] += 1;
+        }
+        analysis.gather_ptr = gather_ptr;
+        analysis.gather = gather;
         analysis.entry_super = entry_super;
         Ok(analysis)
     }
@@ -460,9 +478,12 @@ impl NumericSymmetricLu {
         self.dirty.clear();
         self.dirty.resize(ns, !partial);
         if partial {
-            for ((&new, &old), &s) in a.iter().zip(&self.factored).zip(&sy.entry_super) {
+            // Compared and kept in one pass: `factored` holds `a` from here on, and a
+            // failure below leaves `factored_on` unset, so the next call is whole anyway.
+            for ((&new, old), &s) in a.iter().zip(&mut self.factored).zip(&sy.entry_super) {
                 if new.to_bits() != old.to_bits() {
                     self.dirty[s] = true;
+                    *old = new;
                 }
             }
             for s in 0..ns {
@@ -471,21 +492,13 @@ impl NumericSymmetricLu {
                     self.dirty[s] = updates.iter().any(|up| self.dirty[up.d]);
                 }
             }
-            for s in (0..ns).filter(|&s| self.dirty[s]) {
-                self.values[sy.offset[s]..sy.offset[s + 1]].fill(0.0);
-            }
-            for ((&v, &k), &s) in a.iter().zip(&sy.slot).zip(&sy.entry_super) {
-                if self.dirty[s] {
-                    self.values[k] = v;
-                }
-            }
         } else {
-            self.values.clear();
-            self.values.resize(sy.len, 0.0);
-            for (&v, &k) in a.iter().zip(&sy.slot) {
-                self.values[k] = v;
-            }
+            self.factored.clear();
+            self.factored.extend_from_slice(a);
         }
+        // Each recomputed supernode zeroes and gathers its own panels when it is computed
+        // (`factor_supernode`), while they are about to be used: the others keep theirs.
+        self.values.resize(sy.len, 0.0);
         self.flops_total += sy.total_flops;
         let mut recomputed = 0.0;
         for s in (0..ns).filter(|&s| self.dirty[s]) {
@@ -535,7 +548,7 @@ impl NumericSymmetricLu {
                 for (first, root, piece) in pieces {
                     let base = sy.offset[first];
                     for s in (first..=root).filter(|&s| dirty[s]) {
-                        factor_supernode(sy, s, piece, base, scratch)?;
+                        factor_supernode(sy, s, a, piece, base, scratch)?;
                     }
                 }
                 Ok(())
@@ -567,11 +580,9 @@ impl NumericSymmetricLu {
         }
         for s in 0..ns {
             if dirty[s] && !in_subtree[s] {
-                factor_supernode(sy, s, &mut self.values, 0, &mut self.scratch[0])?;
+                factor_supernode(sy, s, a, &mut self.values, 0, &mut self.scratch[0])?;
             }
         }
-        self.factored.clear();
-        self.factored.extend_from_slice(a);
         self.factored_on = Some(sy.id);
         Ok(())
     }
@@ -640,19 +651,24 @@ impl NumericSymmetricLu {
 
 /// Computes supernode `s`'s panels (module docs, "numeric") in `values`, the value array
 /// from index `base` on, which holds `s`'s panels and those of its descendants: gathers
-/// their updates, factorizes the diagonal block without pivoting (refusing a pivot below
+/// its entries of `a` (the values of `A`) into zeroed panels and its descendants' updates, factorizes the diagonal block without pivoting (refusing a pivot below
 /// [`PIVOT_TOLERANCE`] of its column of L and row of U) and solves for the off-diagonal
 /// panels. The same operations in the same order wherever it runs, so the factors do not
 /// depend on the threads.
 fn factor_supernode(
     sy: &SymbolicSymmetricLu,
     s: usize,
+    a: &[f64],
     values: &mut [f64],
     base: usize,
     scratch: &mut Scratch,
 ) -> std::result::Result<(), PivotFailure> {
     let (f, k, r, rows) = sy.panels(s);
     let m = k + r;
+    values[sy.offset[s] - base..sy.offset[s + 1] - base].fill(0.0);
+    for &(i, slot) in &sy.gather[sy.gather_ptr[s]..sy.gather_ptr[s + 1]] {
+        values[slot - base] = a[i];
+    }
     for j in 0..k {
         scratch.position[f + j] = j;
     }
@@ -744,10 +760,13 @@ fn dense_product(
     rows: usize,
     cols: usize,
 ) {
-    out.clear();
-    out.resize(rows * cols, 0.0);
+    if out.len() < rows * cols {
+        out.resize(rows * cols, 0.0);
+    }
+    let out = &mut out[..rows * cols];
     let k = a.ncols();
     if rows * cols * k <= 512 {
+        out.fill(0.0);
         for c in 0..cols {
             for p in 0..k {
                 let w = b[(c, p)];
@@ -760,6 +779,7 @@ fn dense_product(
             }
         }
     } else {
+        // Replace does not read what `out` held.
         let dst = MatMut::from_column_major_slice_mut(out, rows, cols);
         matmul(dst, Accum::Replace, a, b.transpose(), 1.0, Par::Seq);
     }
