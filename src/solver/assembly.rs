@@ -1120,4 +1120,71 @@ mod tests {
             assert_eq!(bits(&next.residual), bits(&again.residual));
         }
     }
+
+    /// The element output buffers are kept between the evaluations of an increment and
+    /// sized, never cleared, because every element overwrites its own force and stiffness.
+    /// Buffers full of NaN from an earlier use must therefore give, bit for bit, what
+    /// fresh ones give, for every element kind (an element that accumulated into its
+    /// outputs would fail here).
+    #[test]
+    fn stale_element_buffers_change_nothing() {
+        use crate::element::ElementKind;
+        for kind in [ElementKind::Hexahedron, ElementKind::SolidShell] {
+            let (mut model, x) = pressed_strip(false);
+            model.settings.element = kind;
+            let dofs = DofMap::new(&model);
+            let pattern = Arc::new(dofs.pattern(&model));
+            let is_fixed = vec![false; dofs.n_dofs];
+            let per_elem = model.element().unwrap().point_count();
+            let points = vec![PointState::default(); model.mesh.hexes.len() * per_elem];
+            let contact: Vec<Vec<ContactNodeState>> = model
+                .contacts
+                .iter()
+                .map(|c| vec![ContactNodeState::default(); c.candidates.len()])
+                .collect();
+            let context = || IncrementContext {
+                model: &model,
+                dofs: &dofs,
+                pattern: pattern.clone(),
+                time: 1.0,
+                poses: model.contacts.iter().map(|c| c.tool.pose(1.0)).collect(),
+                committed_points: &points,
+                committed_contact: &contact,
+                frozen: None,
+                is_fixed: &is_fixed,
+                forced: None,
+                element_memory: Default::default(),
+                keep_element_jacobian: false,
+                element_buffers: Default::default(),
+            };
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let mut times = PhaseTimes::default();
+            let poisoned = || {
+                let ctx = context();
+                {
+                    let n = model.mesh.hexes.len() * crate::element::hex8::DOFS;
+                    let mut buffers = ctx.element_buffers();
+                    buffers.force = vec![f64::NAN; n];
+                    buffers.stiffness = vec![f64::NAN; n * crate::element::hex8::DOFS];
+                }
+                ctx
+            };
+            // Each comparison is a context's first evaluation: a solid-shell's later ones
+            // start their local solve from what the first remembered, equal to round-off.
+            let fresh = context().evaluate(&x, &mut times).unwrap();
+            let again = poisoned().evaluate(&x, &mut times).unwrap();
+            assert!(fresh.residual.iter().all(|v| v.is_finite()), "{kind:?}");
+            assert_eq!(bits(&again.residual), bits(&fresh.residual), "{kind:?}");
+            assert_eq!(bits(&again.f_int), bits(&fresh.f_int), "{kind:?}");
+            assert_eq!(
+                bits(&again.jacobian.values),
+                bits(&fresh.jacobian.values),
+                "{kind:?}"
+            );
+            // A residual-only evaluation leaves the stiffness as it is and reads none of it.
+            let fresh = context().evaluate_residual(&x, &mut times).unwrap();
+            let again = poisoned().evaluate_residual(&x, &mut times).unwrap();
+            assert_eq!(bits(&again.residual), bits(&fresh.residual), "{kind:?}");
+        }
+    }
 }
