@@ -982,6 +982,33 @@ mod tests {
         (model, x)
     }
 
+    /// A fresh increment context at time 1 (no frozen frames, no forced statuses, nothing
+    /// remembered, the element stiffness not kept).
+    fn context_at_one<'a>(
+        model: &'a Model,
+        dofs: &'a DofMap,
+        pattern: Arc<SparsePattern>,
+        points: &'a [PointState],
+        contact: &'a [Vec<ContactNodeState>],
+        is_fixed: &'a [bool],
+    ) -> IncrementContext<'a> {
+        IncrementContext {
+            model,
+            dofs,
+            pattern,
+            time: 1.0,
+            poses: model.contacts.iter().map(|c| c.tool.pose(1.0)).collect(),
+            committed_points: points,
+            committed_contact: contact,
+            frozen: None,
+            is_fixed,
+            forced: None,
+            element_memory: Default::default(),
+            keep_element_jacobian: false,
+            element_buffers: Default::default(),
+        }
+    }
+
     /// A residual-only evaluation gives, bit for bit, everything a full one gives but the
     /// Jacobian (residual, forces, support forces, point states, contact output): so the
     /// line search, which judges a trial by these alone, takes the same decisions with it.
@@ -1022,21 +1049,8 @@ mod tests {
                         .collect()
                 })
                 .collect();
-            let mut ctx = IncrementContext {
-                model: &model,
-                dofs: &dofs,
-                pattern,
-                time: 1.0,
-                poses: model.contacts.iter().map(|c| c.tool.pose(1.0)).collect(),
-                committed_points: &points,
-                committed_contact: &contact,
-                frozen: None,
-                is_fixed: &is_fixed,
-                forced: None,
-                element_memory: Default::default(),
-                keep_element_jacobian: true,
-                element_buffers: Default::default(),
-            };
+            let mut ctx = context_at_one(&model, &dofs, pattern, &points, &contact, &is_fixed);
+            ctx.keep_element_jacobian = true;
             let mut times = PhaseTimes::default();
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             let full = ctx.evaluate(&x, &mut times).unwrap();
@@ -1142,21 +1156,8 @@ mod tests {
                 .iter()
                 .map(|c| vec![ContactNodeState::default(); c.candidates.len()])
                 .collect();
-            let context = || IncrementContext {
-                model: &model,
-                dofs: &dofs,
-                pattern: pattern.clone(),
-                time: 1.0,
-                poses: model.contacts.iter().map(|c| c.tool.pose(1.0)).collect(),
-                committed_points: &points,
-                committed_contact: &contact,
-                frozen: None,
-                is_fixed: &is_fixed,
-                forced: None,
-                element_memory: Default::default(),
-                keep_element_jacobian: false,
-                element_buffers: Default::default(),
-            };
+            let context =
+                || context_at_one(&model, &dofs, pattern.clone(), &points, &contact, &is_fixed);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             let mut times = PhaseTimes::default();
             let poisoned = || {

@@ -651,7 +651,8 @@ impl NumericSymmetricLu {
 
 /// Computes supernode `s`'s panels (module docs, "numeric") in `values`, the value array
 /// from index `base` on, which holds `s`'s panels and those of its descendants: gathers
-/// its entries of `a` (the values of `A`) into zeroed panels and its descendants' updates, factorizes the diagonal block without pivoting (refusing a pivot below
+/// its entries of `a` (the values of `A`) into zeroed panels and its descendants'
+/// updates, factorizes the diagonal block without pivoting (refusing a pivot below
 /// [`PIVOT_TOLERANCE`] of its column of L and row of U) and solves for the off-diagonal
 /// panels. The same operations in the same order wherever it runs, so the factors do not
 /// depend on the threads.
