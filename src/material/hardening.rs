@@ -176,6 +176,16 @@ impl Hardening {
         }
     }
 
+    /// The slope [`yield_stress_and_slope`](Self::yield_stress_and_slope) pairs with the
+    /// yield stress `sy = σ_y(ε̄p)` a caller already has: the same bits, without the
+    /// Swift law's second power.
+    pub fn slope_given_yield_stress(&self, eps_p: f64, sy: f64) -> f64 {
+        match self {
+            Hardening::Swift { eps0, n, .. } => n * sy / (eps0 + eps_p.max(0.0)),
+            _ => self.slope(eps_p),
+        }
+    }
+
     /// Initial yield stress `σ_y(0)`.
     pub fn initial_yield_stress(&self) -> f64 {
         self.yield_stress(0.0)
@@ -219,6 +229,31 @@ mod tests {
                 (fd - s).abs() <= 1e-6 * s.abs().max(1.0),
                 "{h:?} at {e}: {s} vs {fd}"
             );
+        }
+    }
+
+    /// What the return map's first iterate takes instead of a call: the yield stress it
+    /// already has and [`Hardening::slope_given_yield_stress`], bit for bit the call's
+    /// pair, for every law, at zero (and a negative round-off) and in the hardening range.
+    #[test]
+    fn slope_from_a_known_yield_stress_is_the_pairs_own() {
+        let laws = [
+            Hardening::swift(500.0, 0.01, 0.2).unwrap(),
+            Hardening::swift(565.32, 0.007117, 0.2589).unwrap(),
+            Hardening::voce(100.0, 50.0, 10.0).unwrap(),
+            Hardening::linear(200.0, 1000.0).unwrap(),
+            Hardening::tabulated(vec![0.0, 0.1, 0.3], vec![100.0, 150.0, 170.0]).unwrap(),
+        ];
+        for h in &laws {
+            for e in [-1e-18, -0.0, 0.0, 1e-12, 0.003, 0.1, 0.3, 0.77] {
+                let (sy, slope) = h.yield_stress_and_slope(e + 0.0);
+                assert_eq!(h.yield_stress(e).to_bits(), sy.to_bits(), "{h:?} at {e}");
+                assert_eq!(
+                    h.slope_given_yield_stress(e, h.yield_stress(e)).to_bits(),
+                    slope.to_bits(),
+                    "{h:?} at {e}"
+                );
+            }
         }
     }
 

@@ -111,12 +111,14 @@ impl SpectralReturn {
     }
 
     /// The return of `sig_tr` (outside the surface: `φ(σ_tr) > σ_y(ε̄p_n)`) from `ebar_n`,
-    /// converged to `|g| <= tol` (stress units) or to round-off in `γ`. None if Newton did
-    /// not converge in its iterations (the caller then uses the general return).
+    /// where the caller already has `sy_n = σ_y(ε̄p_n)`, converged to `|g| <= tol` (stress
+    /// units) or to round-off in `γ`. None if Newton did not converge in its iterations
+    /// (the caller then uses the general return).
     pub fn solve(
         &self,
         sig_tr: &Voigt,
         ebar_n: f64,
+        sy_n: f64,
         hardening: &Hardening,
         tol: f64,
     ) -> Option<SpectralPoint> {
@@ -129,7 +131,13 @@ impl SpectralReturn {
                 return None;
             }
             let dl = gamma * phi;
-            let (sy, h) = hardening.yield_stress_and_slope(ebar_n + dl);
+            // At γ = 0 (the first iterate) the hardening is at ε̄p_n, whose yield
+            // stress the caller computed: the same values as a call, one power less.
+            let (sy, h) = if gamma == 0.0 {
+                (sy_n, hardening.slope_given_yield_stress(ebar_n, sy_n))
+            } else {
+                hardening.yield_stress_and_slope(ebar_n + dl)
+            };
             let g = phi - sy;
             if g.abs() <= tol {
                 return Some(self.point(&c, gamma, phi));

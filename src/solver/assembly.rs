@@ -450,6 +450,29 @@ impl IncrementContext<'_> {
         self.evaluate_with(x, times, false)
     }
 
+    /// A residual-only evaluation at `x` whose elements are not run: `f_int` are their
+    /// internal forces at `x` (the committed state's, kept from its converged evaluation),
+    /// and loads, contact and force control are evaluated as in
+    /// [`Self::evaluate_residual`]. It carries no point states and is not counted as an
+    /// element evaluation.
+    pub fn residual_with_forces(
+        &self,
+        x: &[f64],
+        f_int: Vec<f64>,
+        times: &mut PhaseTimes,
+    ) -> Result<Evaluation> {
+        let part = ElementPart {
+            jacobian: SparseMatrix {
+                pattern: self.pattern.clone(),
+                values: Vec::new(),
+            },
+            f_int,
+            trial_points: Vec::new(),
+            approximate_elements: 0,
+        };
+        self.with_contact(x, part, times, false, None)
+    }
+
     /// The Jacobian of a residual-only evaluation `eval` at the same `x`, so that an
     /// accepted line-search cut needs no second evaluation: the element tangents (the
     /// kernel run again with its tangent: the same point states) and their assembly, and

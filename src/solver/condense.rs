@@ -155,9 +155,13 @@ pub struct Condenser {
     rows: Vec<Vec<(usize, usize)>>,
     /// Rows of eliminated nodes' local blocks (full index), to skip when copying.
     condensed_row: Vec<bool>,
-    /// Per full row, how many of its entries land in the reduced matrix (columns that are
-    /// not eliminated multipliers): the contributions [`Self::add_local_row`] makes.
-    reduced_len: Vec<usize>,
+    /// Per full row, its entries that land in the reduced matrix (columns that are not
+    /// eliminated multipliers), as (reduced column, value position) in `rows`' order: the
+    /// contributions [`Self::add_local_row`] makes, listed once instead of filtered per
+    /// call; row `r` owns `reduced_entries[reduced_ptr[r]..reduced_ptr[r + 1]]` (u32: the
+    /// full pattern has fewer than 2^32 entries).
+    reduced_entries: Vec<(u32, u32)>,
+    reduced_ptr: Vec<usize>,
     /// Eliminated multiplier dof -> (index in `nodes`, row of C that recovers it).
     owner: Vec<Option<(usize, usize)>>,
     /// The slot plan: the reduced matrix's value index of every contribution, in the order
@@ -174,7 +178,7 @@ pub struct Condenser {
     /// entries of `rows` that are not eliminated multipliers, listed once instead of
     /// filtered per solve); local row `r` in that order owns
     /// `back_terms[back_ptr[r]..back_ptr[r + 1]]`.
-    back_terms: Vec<(usize, usize)>,
+    back_terms: Vec<(u32, u32)>,
     back_ptr: Vec<usize>,
     /// Calls solved through the mixed system because no local elimination existed.
     fallbacks: AtomicUsize,
@@ -318,7 +322,7 @@ impl Condenser {
             }
         }
         let pattern = Arc::new(SparsePattern::from_entries(next, entries).with_groups(groups));
-        if pattern.nnz() > u32::MAX as usize {
+        if pattern.nnz() > u32::MAX as usize || full.nnz() > u32::MAX as usize {
             return None;
         }
         let last = Reduction {
@@ -340,7 +344,8 @@ impl Condenser {
             condensed_row,
             owner,
             slots: Vec::new(),
-            reduced_len: Vec::new(),
+            reduced_entries: Vec::new(),
+            reduced_ptr: vec![0],
             segment_start: Vec::new(),
             kept_rows: Vec::new(),
             last: Mutex::new(last),
@@ -348,24 +353,23 @@ impl Condenser {
             back_ptr: vec![0],
             fallbacks: AtomicUsize::new(0),
         };
+        for row in &condenser.rows {
+            let kept = row.iter().filter_map(|&(col, k)| {
+                condenser.reduced_index[col].map(|ci| (ci as u32, k as u32))
+            });
+            condenser.reduced_entries.extend(kept);
+            condenser.reduced_ptr.push(condenser.reduced_entries.len());
+        }
         for e in &condenser.nodes {
             for i in 0..e.width() {
                 let kept = condenser.rows[e.local_row(i)]
                     .iter()
-                    .filter(|&&(col, _)| condenser.reduced_index[col].is_some());
+                    .filter(|&&(col, _)| condenser.reduced_index[col].is_some())
+                    .map(|&(col, k)| (col as u32, k as u32));
                 condenser.back_terms.extend(kept);
                 condenser.back_ptr.push(condenser.back_terms.len());
             }
         }
-        condenser.reduced_len = condenser
-            .rows
-            .iter()
-            .map(|row| {
-                row.iter()
-                    .filter(|&&(col, _)| condenser.reduced_index[col].is_some())
-                    .count()
-            })
-            .collect();
         // Record the plan: the walk only depends on the pattern, so zero values will do.
         let zeros = vec![0.0; full.nnz()];
         let mut coefficients = Vec::new();
@@ -495,15 +499,12 @@ impl Condenser {
         factor: f64,
     ) {
         let row = e.local_row(i);
+        let entries = &self.reduced_entries[self.reduced_ptr[row]..self.reduced_ptr[row + 1]];
         if sink.skips(factor) {
-            sink.skip(self.reduced_len[row]);
+            sink.skip(entries.len());
             return;
         }
-        for &(col, k) in &self.rows[row] {
-            if let Some(ci) = self.reduced_index[col] {
-                sink.add(ri, ci, factor * j[k]);
-            }
-        }
+        sink.add_row(ri, entries, j, factor);
     }
 
     /// Walks every contribution to the reduced matrix, in a fixed order that depends only
@@ -728,7 +729,10 @@ impl Condenser {
                 let row = e.local_row(i);
                 let terms =
                     &self.back_terms[self.back_ptr[local + i]..self.back_ptr[local + i + 1]];
-                let n_du: f64 = terms.iter().map(|&(col, k)| j.values[k] * dx[col]).sum();
+                let n_du: f64 = terms
+                    .iter()
+                    .map(|&(col, k)| j.values[k as usize] * dx[col as usize])
+                    .sum();
                 -residual[row] - n_du
             }));
             local += w;
@@ -750,6 +754,13 @@ trait Contributions {
     /// kept row, or one eliminated node's three condensed rows, in the walk's order.
     fn begin_segment(&mut self, _index: usize) {}
     fn add(&mut self, row: usize, col: usize, value: f64);
+    /// `factor` times the Jacobian values of a local row's reduced `entries` ((reduced
+    /// column, value position) pairs), added to reduced row `row` in their order.
+    fn add_row(&mut self, row: usize, entries: &[(u32, u32)], j: &[f64], factor: f64) {
+        for &(col, k) in entries {
+            self.add(row, col as usize, factor * j[k as usize]);
+        }
+    }
     /// Whether the local row about to be added with `factor` may be skipped (then
     /// [`Self::skip`] is called with its number of contributions instead of `add` for
     /// each).
@@ -808,6 +819,15 @@ impl Contributions for Replay<'_> {
             self.values[self.slots[self.next] as usize] += value;
         }
         self.next += 1;
+    }
+    fn add_row(&mut self, _row: usize, entries: &[(u32, u32)], j: &[f64], factor: f64) {
+        let end = self.next + entries.len();
+        if self.active {
+            for (&(_, k), &slot) in entries.iter().zip(&self.slots[self.next..end]) {
+                self.values[slot as usize] += factor * j[k as usize];
+            }
+        }
+        self.next = end;
     }
     fn skips(&self, factor: f64) -> bool {
         factor == 0.0 || !self.active

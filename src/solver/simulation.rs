@@ -82,6 +82,11 @@ pub struct Simulation {
     /// there), where every attempt of the next increment starts
     /// ([`super::assembly::ElementMemory`]); empty before the first increment.
     pub(super) committed_memory: Vec<f64>,
+    /// The elements' internal forces at the committed state (the converged evaluation's),
+    /// so that the extrapolation guard's evaluation at the committed unknowns needs no
+    /// element pass (`Simulation::committed_residual`); `None` before the first increment
+    /// and after a restore.
+    pub(super) committed_forces: Option<Vec<f64>>,
     pub(super) condenser: Option<Condenser>,
     /// Committed unknowns [u, lambda].
     pub(super) x: Vec<f64>,
@@ -193,6 +198,7 @@ impl Simulation {
             is_fixed,
             linear: Solver::new(model.settings.linear_solver),
             committed_memory: Vec::new(),
+            committed_forces: None,
             points,
             contact,
             time: 0.0,
@@ -537,6 +543,7 @@ impl Simulation {
         self.last_step = Some((dt, du.collect()));
         self.x = x;
         self.points = eval.trial_points;
+        self.committed_forces = Some(eval.f_int);
         self.time = t_new;
         self.increments_done += 1;
         IncrementReport {
@@ -595,6 +602,7 @@ impl Simulation {
         self.controller = state.controller;
         self.last_step = state.last_step;
         self.committed_memory = state.element_memory;
+        self.committed_forces = None;
     }
 
     /// Replaces the settings of a running simulation (after a rollback in the REPL, say).
