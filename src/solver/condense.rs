@@ -599,12 +599,19 @@ impl Condenser {
             kept.jacobian.clone_from(&j.values);
             kept.matrix.values.fill(0.0);
         }
+        // Every segment dirty (a Newton step's new Jacobian): one clear of the whole matrix
+        // instead of each segment's slots, the same sums (a reduced entry receives the
+        // contributions of one segment only, from zero either way).
+        let replay_all = !partial || kept.dirty.iter().all(|&d| d);
+        if partial && replay_all {
+            kept.matrix.values.fill(0.0);
+        }
         kept.rhs.clear();
         kept.rhs.resize(self.pattern.n, 0.0);
         let mut replay = Replay {
             slots: &self.slots,
             segment_start: &self.segment_start,
-            dirty: partial.then_some(&kept.dirty[..]),
+            dirty: (!replay_all).then_some(&kept.dirty[..]),
             active: true,
             next: 0,
             values: &mut kept.matrix.values,
