@@ -956,38 +956,19 @@ fn implicit_mu(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::{ContactStatus, FrictionLaw};
-    use crate::element::StrainTheory;
-    use crate::geometry::Cylinder;
-    use crate::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
-    use crate::mesh::Mesh;
+    use crate::contact::ContactStatus;
+    use crate::solver::test_models::strip_under_roller;
     use crate::tool::schedule::Schedule;
-    use crate::tool::{ForceControl, ScalarSchedule, Tool};
+    use crate::tool::{ForceControl, ScalarSchedule};
 
     /// A Hill48 strip (finite strain) under a rough cylinder pushed into it, optionally
     /// force-controlled, and the unknowns of a state where the cylinder presses the strip:
     /// top bulged into the roller, sheared sideways, multipliers of mixed sign.
     fn pressed_strip(force_controlled: bool) -> (Model, Vec<f64>) {
-        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(6.0, 1.0, 1.0), [12, 1, 3]).unwrap();
-        let material = ElastoPlastic::new(
-            LinearElastic::new(70e3, 0.33).unwrap(),
-            Hill48::from_lankford(0.7, 1.3, 2.1).unwrap(),
-            Hardening::swift(500.0, 0.01, 0.22).unwrap(),
-        );
-        let mut model = Model::new(mesh, Arc::new(material)).unwrap();
-        let cylinder = Cylinder::new(Vec3::new(3.0, 0.0, 6.0), Vec3::y(), 5.0).unwrap();
-        let mut tool = Tool::new("roller", Arc::new(cylinder));
-        tool.schedule = Schedule::new(vec![(0.0, Vec3::zeros()), (1.0, Vec3::zeros())]).unwrap();
-        tool.friction = FrictionLaw::coulomb(0.2).unwrap();
-        if force_controlled {
-            tool.force_control =
-                Some(ForceControl::new(-Vec3::z(), ScalarSchedule::constant(50.0)).unwrap());
-        }
-        model.add_tool(tool, "z+", None).unwrap();
-        model
-            .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
-            .unwrap();
-        model.settings.kinematics = StrainTheory::Finite;
+        let still = Schedule::new(vec![(0.0, Vec3::zeros()), (1.0, Vec3::zeros())]).unwrap();
+        let force_control = force_controlled
+            .then(|| ForceControl::new(-Vec3::z(), ScalarSchedule::constant(50.0)).unwrap());
+        let model = strip_under_roller(500.0, 3.0, still, force_control);
         let dofs = DofMap::new(&model);
         let mut x = vec![0.0; dofs.n_dofs];
         for (node, p) in model.mesh.nodes.iter().enumerate() {

@@ -24,6 +24,8 @@ pub mod stepping;
 pub mod subtree_split;
 pub mod symmetric_lu;
 pub mod system_dump;
+#[cfg(test)]
+pub(crate) mod test_models;
 
 pub use energy::EnergyBalance;
 pub use model::{Model, SolverSettings};

@@ -665,15 +665,9 @@ pub(super) fn norm(v: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::FrictionLaw;
-    use crate::element::StrainTheory;
-    use crate::geometry::{Cylinder, Vec3};
-    use crate::material::{ElastoPlastic, Hardening, Hill48, LinearElastic};
-    use crate::mesh::Mesh;
-    use crate::solver::Model;
+    use crate::geometry::Vec3;
+    use crate::solver::test_models::strip_under_roller;
     use crate::tool::schedule::Schedule;
-    use crate::tool::{ScalarSchedule, Tool};
-    use std::sync::Arc;
 
     /// The extrapolation guard's reference without an element pass
     /// (`Simulation::committed_residual`): after increments of a Hill48 strip (finite
@@ -683,27 +677,13 @@ mod tests {
     /// do the residuals; without kept forces (after a restore) the pass is run.
     #[test]
     fn the_guard_reference_from_kept_forces_is_a_fresh_pass() {
-        let mesh = Mesh::block(Vec3::zeros(), Vec3::new(6.0, 1.0, 1.0), [12, 1, 3]).unwrap();
-        let material = ElastoPlastic::new(
-            LinearElastic::new(70e3, 0.33).unwrap(),
-            Hill48::from_lankford(0.7, 1.3, 2.1).unwrap(),
-            Hardening::swift(100.0, 0.01, 0.22).unwrap(),
-        );
-        let mut model = Model::new(mesh, Arc::new(material)).unwrap();
-        let cylinder = Cylinder::new(Vec3::new(2.0, 0.0, 6.0), Vec3::y(), 5.0).unwrap();
-        let mut tool = Tool::new("roller", Arc::new(cylinder));
-        tool.schedule = Schedule::new(vec![
+        let drag = Schedule::new(vec![
             (0.0, Vec3::zeros()),
             (0.5, Vec3::new(0.0, 0.0, -0.05)),
             (1.0, Vec3::new(1.0, 0.0, -0.05)),
         ])
         .unwrap();
-        tool.friction = FrictionLaw::coulomb(0.2).unwrap();
-        model.add_tool(tool, "z+", None).unwrap();
-        model
-            .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
-            .unwrap();
-        model.settings.kinematics = StrainTheory::Finite;
+        let mut model = strip_under_roller(100.0, 2.0, drag, None);
         model.settings.increments = 8;
         let mut sim = Simulation::new(model).unwrap();
         let mut times = PhaseTimes::default();
