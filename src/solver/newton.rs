@@ -671,10 +671,10 @@ mod tests {
 
     /// The extrapolation guard's reference without an element pass
     /// (`Simulation::committed_residual`): after increments of a Hill48 strip (finite
-    /// strain, yielding) pressed and dragged by a rough roller, the kept converged forces
-    /// equal a fresh residual-only pass at the committed unknowns with the next
-    /// increment's tools to round-off (a zero increment from the committed state), and so
-    /// do the residuals; without kept forces (after a restore) the pass is run.
+    /// strain, yielding) pressed (four increments) and dragged (two) by a rough roller, the
+    /// kept converged forces equal a fresh residual-only pass at the committed unknowns with
+    /// the next increment's tools to round-off (a zero increment from the committed state),
+    /// and so do the residuals; without kept forces (after a restore) the pass is run.
     #[test]
     fn the_guard_reference_from_kept_forces_is_a_fresh_pass() {
         let drag = Schedule::new(vec![
@@ -687,7 +687,7 @@ mod tests {
         model.settings.increments = 8;
         let mut sim = Simulation::new(model).unwrap();
         let mut times = PhaseTimes::default();
-        for _ in 0..4 {
+        for _ in 0..6 {
             sim.step().unwrap();
             let t_next = sim.time + 0.125;
             let ctx = sim.context(t_next, None);
@@ -718,6 +718,10 @@ mod tests {
                 "the tools moved nothing"
             );
         }
+        assert!(
+            sim.points.iter().any(|p| p.eq_plastic_strain > 0.0),
+            "the strip did not yield"
+        );
         sim.restore_state(sim.saved_state());
         let t_next = sim.time + 0.125;
         let ctx = sim.context(t_next, None);
