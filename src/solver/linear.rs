@@ -524,9 +524,19 @@ struct BorderedSystem<F> {
     border: Vec<usize>,
     /// Full unknown -> index in A (None: a border unknown).
     inner_index: Vec<Option<usize>>,
-    slots: Vec<Slot>,
-    inner_pattern: Arc<SparsePattern>,
+    /// For each entry of A, the position of its value in the full matrix (every entry of
+    /// A has exactly one), so that A is a gather of the full values.
+    inner_source: Vec<usize>,
+    /// The full matrix's entries in B, C or D, with their positions there.
+    border_slots: Vec<(usize, Slot)>,
     inner: F,
+    /// A, the right-hand sides `[f, B]` and the dense C and D, kept from call to call: A's
+    /// values are all overwritten by the gather, C and D only ever hold the pattern's
+    /// positions, and the right-hand sides are rewritten whole.
+    matrix: SparseMatrix,
+    rhs: Vec<f64>,
+    c_mat: nalgebra::DMatrix<f64>,
+    d_mat: nalgebra::DMatrix<f64>,
 }
 
 impl<F: Factorization> BorderedSystem<F> {
@@ -588,14 +598,28 @@ impl<F: Factorization> BorderedSystem<F> {
                     col: border_index[col].expect("a border unknown"),
                 },
             })
-            .collect();
+            .collect::<Vec<Slot>>();
+        let mut inner_source = vec![usize::MAX; inner_pattern.nnz()];
+        let mut border_slots = Vec::new();
+        for (i, slot) in slots.into_iter().enumerate() {
+            match slot {
+                Slot::A(k) => inner_source[k] = i,
+                other => border_slots.push((i, other)),
+            }
+        }
+        debug_assert!(inner_source.iter().all(|&i| i != usize::MAX));
+        let (n_a, m) = (next, border.len());
         Ok(BorderedSystem {
             full: full.clone(),
             border: border.to_vec(),
             inner_index,
-            slots,
-            inner_pattern,
+            inner_source,
+            border_slots,
             inner: F::default(),
+            matrix: SparseMatrix::zeros(inner_pattern),
+            rhs: vec![0.0; n_a * (m + 1)],
+            c_mat: nalgebra::DMatrix::zeros(m, n_a),
+            d_mat: nalgebra::DMatrix::zeros(m, m),
         })
     }
 
@@ -604,15 +628,18 @@ impl<F: Factorization> BorderedSystem<F> {
     }
 
     fn solve(&mut self, a: &SparseMatrix, b: &mut [f64]) -> Result<()> {
-        let (n_a, m) = (self.inner_pattern.n, self.border.len());
-        let mut inner = SparseMatrix::zeros(self.inner_pattern.clone());
-        // Columns: f, then B (n_a x m, column-major).
-        let mut rhs = vec![0.0; n_a * (m + 1)];
-        let mut c_mat = nalgebra::DMatrix::<f64>::zeros(m, n_a);
-        let mut d_mat = nalgebra::DMatrix::<f64>::zeros(m, m);
-        for (&v, slot) in a.values.iter().zip(&self.slots) {
-            match *slot {
-                Slot::A(k) => inner.values[k] = v,
+        let (n_a, m) = (self.matrix.pattern.n, self.border.len());
+        let (inner, rhs) = (&mut self.matrix, &mut self.rhs);
+        let (c_mat, d_mat) = (&mut self.c_mat, &mut self.d_mat);
+        for (v, &i) in inner.values.iter_mut().zip(&self.inner_source) {
+            *v = a.values[i];
+        }
+        // Columns: f, then B (n_a x m, column-major); the last solve left its solution here.
+        rhs[n_a..].fill(0.0);
+        for &(i, slot) in &self.border_slots {
+            let v = a.values[i];
+            match slot {
+                Slot::A(_) => unreachable!("A's entries are gathered"),
                 Slot::B { row, col } => rhs[(col + 1) * n_a + row] = v,
                 Slot::C { row, col } => c_mat[(row, col)] = v,
                 Slot::D { row, col } => d_mat[(row, col)] = v,
@@ -623,15 +650,15 @@ impl<F: Factorization> BorderedSystem<F> {
                 rhs[*i] = b[d];
             }
         }
-        self.inner.factor_and_solve(&inner, &mut rhs, m + 1)?;
+        self.inner.factor_and_solve(inner, rhs, m + 1)?;
         let z0 = nalgebra::DVectorView::from_slice(&rhs[..n_a], n_a);
         let z = nalgebra::DMatrixView::from_slice(&rhs[n_a..], n_a, m);
         let g = nalgebra::DVector::from_iterator(m, self.border.iter().map(|&d| b[d]));
-        let schur = d_mat - &c_mat * z;
+        let schur = &*d_mat - &*c_mat * z;
         let y = schur
             .clone()
             .lu()
-            .solve(&(g - &c_mat * z0))
+            .solve(&(g - &*c_mat * z0))
             .filter(|y| y.iter().all(|v| v.is_finite()))
             .ok_or_else(|| {
                 Error::LinearSolver(format!(
@@ -734,6 +761,27 @@ mod tests {
             .solve_bordered(&a, &mut y, &[n - 1, 0, dense])
             .unwrap();
         assert_eq!(solver.symbolic_count, count);
+        // Other values and another right-hand side on the kept system (its matrix, dense
+        // blocks and right-hand sides reused), both solvers: nothing of the last call
+        // leaks into the next.
+        let mut other = a.clone();
+        for (k, v) in other.values.iter_mut().enumerate() {
+            *v *= 1.0 + 0.05 * ((k * 13 % 7) as f64 - 3.0) / 3.0;
+        }
+        let x2: Vec<f64> = (0..n).map(|i| (i as f64 * 0.91).cos()).collect();
+        let b2 = other.mul_vec(&x2);
+        let mut symmetric = SymmetricLu::default();
+        for (matrix, rhs, expected) in [(&a, &b, &x), (&other, &b2, &x2), (&a, &b, &x)] {
+            for solver in [&mut solver as &mut dyn LinearSolver, &mut symmetric] {
+                let mut y = rhs.clone();
+                solver
+                    .solve_bordered(matrix, &mut y, &[n - 1, 0, dense])
+                    .unwrap();
+                for i in 0..n {
+                    assert!((y[i] - expected[i]).abs() < 1e-12, "unknown {i}");
+                }
+            }
+        }
     }
 
     #[test]
