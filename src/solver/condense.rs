@@ -157,8 +157,8 @@ pub struct Condenser {
     condensed_row: Vec<bool>,
     /// Per full row, its entries that land in the reduced matrix (columns that are not
     /// eliminated multipliers), as (reduced column, value position) in `rows`' order: the
-    /// contributions [`Self::add_local_row`] makes, listed once instead of filtered per
-    /// call; row `r` owns `reduced_entries[reduced_ptr[r]..reduced_ptr[r + 1]]` (u32: the
+    /// contributions [`Self::add_local_row`] makes and the back-substitution's `N du`
+    /// terms, listed once instead of filtered per call; row `r` owns `reduced_entries[reduced_ptr[r]..reduced_ptr[r + 1]]` (u32: the
     /// full pattern has fewer than 2^32 entries).
     reduced_entries: Vec<(u32, u32)>,
     reduced_ptr: Vec<usize>,
@@ -173,13 +173,6 @@ pub struct Condenser {
     kept_rows: Vec<usize>,
     /// The last reduced system and what it was built from, for [`Self::reduce`].
     last: Mutex<Reduction>,
-    /// The back-substitution's `N du` terms, (column, value position) of every kept column
-    /// of each eliminated node's local rows, node after node and row after row (the
-    /// entries of `rows` that are not eliminated multipliers, listed once instead of
-    /// filtered per solve); local row `r` in that order owns
-    /// `back_terms[back_ptr[r]..back_ptr[r + 1]]`.
-    back_terms: Vec<(u32, u32)>,
-    back_ptr: Vec<usize>,
     /// Calls solved through the mixed system because no local elimination existed.
     fallbacks: AtomicUsize,
 }
@@ -349,8 +342,6 @@ impl Condenser {
             segment_start: Vec::new(),
             kept_rows: Vec::new(),
             last: Mutex::new(last),
-            back_terms: Vec::new(),
-            back_ptr: vec![0],
             fallbacks: AtomicUsize::new(0),
         };
         for row in &condenser.rows {
@@ -359,16 +350,6 @@ impl Condenser {
             });
             condenser.reduced_entries.extend(kept);
             condenser.reduced_ptr.push(condenser.reduced_entries.len());
-        }
-        for e in &condenser.nodes {
-            for i in 0..e.width() {
-                let kept = condenser.rows[e.local_row(i)]
-                    .iter()
-                    .filter(|&&(col, _)| condenser.reduced_index[col].is_some())
-                    .map(|&(col, k)| (col as u32, k as u32));
-                condenser.back_terms.extend(kept);
-                condenser.back_ptr.push(condenser.back_terms.len());
-            }
         }
         // Record the plan: the walk only depends on the pattern, so zero values will do.
         let zeros = vec![0.0; full.nnz()];
@@ -597,13 +578,12 @@ impl Condenser {
             self.mark_dirty(kept, j);
         } else {
             kept.jacobian.clone_from(&j.values);
-            kept.matrix.values.fill(0.0);
         }
-        // Every segment dirty (a Newton step's new Jacobian): one clear of the whole matrix
-        // instead of each segment's slots, the same sums (a reduced entry receives the
-        // contributions of one segment only, from zero either way).
+        // The first call, or every segment dirty (a Newton step's new Jacobian): one clear
+        // of the whole matrix instead of each segment's slots, the same sums (a reduced
+        // entry receives the contributions of one segment only, from zero either way).
         let replay_all = !partial || kept.dirty.iter().all(|&d| d);
-        if partial && replay_all {
+        if replay_all {
             kept.matrix.values.fill(0.0);
         }
         kept.rhs.clear();
@@ -726,23 +706,21 @@ impl Condenser {
                 dx[d] = rhs[*ri];
             }
         }
-        // Back-substitution: dl = H (rhs_local - N du), N over the reduced columns.
+        // Back-substitution: dl = H (rhs_local - N du), N over the reduced columns (the
+        // local rows' reduced entries, du read from the reduced solution).
         let mut t = Vec::new();
-        let mut local = 0;
         for e in &self.nodes {
             let w = e.width();
             t.clear();
             t.extend((0..w).map(|i| {
                 let row = e.local_row(i);
-                let terms =
-                    &self.back_terms[self.back_ptr[local + i]..self.back_ptr[local + i + 1]];
+                let terms = &self.reduced_entries[self.reduced_ptr[row]..self.reduced_ptr[row + 1]];
                 let n_du: f64 = terms
                     .iter()
-                    .map(|&(col, k)| j.values[k as usize] * dx[col as usize])
+                    .map(|&(ci, k)| j.values[k as usize] * rhs[ci as usize])
                     .sum();
                 -residual[row] - n_du
             }));
-            local += w;
             let c = &coefficients[e.offset..e.offset + w * w];
             for (p, pair) in e.pairs.iter().enumerate() {
                 for beta in 0..3 {
