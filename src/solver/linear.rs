@@ -496,11 +496,11 @@ impl LinearSolver for Solver {
     }
 }
 
-/// Where an entry of the full matrix goes in the bordered split
-/// `[[A, B], [C, D]]` (A sparse, the border's B, C, D dense).
+/// Where an entry of the full matrix outside A goes in the bordered split
+/// `[[A, B], [C, D]]` (A sparse, gathered by `BorderedSystem::inner_source`; the border's
+/// B, C, D dense).
 #[derive(Clone, Copy, Debug)]
 enum Slot {
-    A(usize),
     B { row: usize, col: usize },
     C { row: usize, col: usize },
     D { row: usize, col: usize },
@@ -578,13 +578,17 @@ impl<F: Factorization> BorderedSystem<F> {
             inner_pattern = inner_pattern.with_groups(inner_groups.collect());
         }
         let inner_pattern = Arc::new(inner_pattern);
-        let slots = entries()
-            .map(|(row, col)| match (inner_index[row], inner_index[col]) {
-                (Some(r), Some(c)) => Slot::A(
-                    inner_pattern
+        let mut inner_source = vec![usize::MAX; inner_pattern.nnz()];
+        let mut border_slots = Vec::new();
+        for (i, (row, col)) in entries().enumerate() {
+            let slot = match (inner_index[row], inner_index[col]) {
+                (Some(r), Some(c)) => {
+                    let k = inner_pattern
                         .position(r, c)
-                        .expect("entry of the inner pattern"),
-                ),
+                        .expect("entry of the inner pattern");
+                    inner_source[k] = i;
+                    continue;
+                }
                 (Some(r), None) => Slot::B {
                     row: r,
                     col: border_index[col].expect("a border unknown"),
@@ -597,15 +601,8 @@ impl<F: Factorization> BorderedSystem<F> {
                     row: border_index[row].expect("a border unknown"),
                     col: border_index[col].expect("a border unknown"),
                 },
-            })
-            .collect::<Vec<Slot>>();
-        let mut inner_source = vec![usize::MAX; inner_pattern.nnz()];
-        let mut border_slots = Vec::new();
-        for (i, slot) in slots.into_iter().enumerate() {
-            match slot {
-                Slot::A(k) => inner_source[k] = i,
-                other => border_slots.push((i, other)),
-            }
+            };
+            border_slots.push((i, slot));
         }
         debug_assert!(inner_source.iter().all(|&i| i != usize::MAX));
         let (n_a, m) = (next, border.len());
@@ -639,7 +636,6 @@ impl<F: Factorization> BorderedSystem<F> {
         for &(i, slot) in &self.border_slots {
             let v = a.values[i];
             match slot {
-                Slot::A(_) => unreachable!("A's entries are gathered"),
                 Slot::B { row, col } => rhs[(col + 1) * n_a + row] = v,
                 Slot::C { row, col } => c_mat[(row, col)] = v,
                 Slot::D { row, col } => d_mat[(row, col)] = v,
