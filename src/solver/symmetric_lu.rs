@@ -67,12 +67,15 @@ use std::sync::Arc;
 pub const PIVOT_TOLERANCE: f64 = 1e-10;
 
 /// One descendant update of a supernode: supernode `d`'s rows `p1..p2` (positions in its row
-/// list) fall into the updated supernode's columns.
+/// list) fall into the updated supernode's columns; `relative[rel..rel + rd - p1]` are the
+/// local rows, in the updated supernode's L panel, of `d`'s rows `p1..` (the positions its
+/// products are subtracted at, the same in every numeric call).
 #[derive(Clone, Copy, Debug)]
 struct Update {
     d: usize,
     p1: usize,
     p2: usize,
+    rel: usize,
 }
 
 /// The symbolic analysis of a pattern: ordering, supernodes, panel layout and the slot of
@@ -93,12 +96,13 @@ pub struct SymbolicSymmetricLu {
     /// Descendant updates of supernode s: `updates[update_ptr[s]..update_ptr[s + 1]]`.
     update_ptr: Vec<usize>,
     updates: Vec<Update>,
+    /// The updates' local rows ([`Update`]).
+    relative: Vec<u32>,
     /// The entries of `A` that supernode s's panels hold, as (index in `A`'s values,
-    /// value index): `gather[gather_ptr[s]..gather_ptr[s + 1]]`.
+    /// value index): `gather[gather_ptr[s]..gather_ptr[s + 1]]`. Indices as `u32`: half
+    /// the memory traffic of `usize` pairs (the pass is bound by it); checked to fit.
     gather_ptr: Vec<usize>,
-    gather: Vec<(usize, usize)>,
-    /// Supernode whose panels hold each entry of `A` (in `A`'s storage order).
-    entry_super: Vec<usize>,
+    gather: Vec<(u32, u32)>,
     /// Floating-point operations of each supernode's numeric step (its descendant updates,
     /// its diagonal block and its triangular solves): what a partial refactorization saves.
     flops: Vec<f64>,
@@ -203,14 +207,33 @@ impl SymbolicSymmetricLu {
                 while p2 < rd.len() && rd[p2] < begin[s + 1] {
                     p2 += 1;
                 }
-                lists[s].push(Update { d, p1, p2 });
+                lists[s].push(Update { d, p1, p2, rel: 0 });
                 p1 = p2;
             }
         }
+        let too_large = |what: &str| {
+            Error::LinearSolver(format!(
+                "{what} beyond 32-bit indices (factor of {len} entries): matrix too large"
+            ))
+        };
         let mut update_ptr = vec![0];
         let mut updates = Vec::new();
-        for list in lists {
-            updates.extend(list);
+        let mut relative = Vec::new();
+        let mut local = vec![0u32; n];
+        for (s, list) in lists.into_iter().enumerate() {
+            let (f, l) = (begin[s], begin[s + 1]);
+            for g in f..l {
+                local[g] = (g - f) as u32;
+            }
+            for (p, &g) in rows[row_ptr[s]..row_ptr[s + 1]].iter().enumerate() {
+                local[g] = u32::try_from(l - f + p).map_err(|_| too_large("a supernode"))?;
+            }
+            for mut up in list {
+                up.rel = relative.len();
+                let rd = &rows[row_ptr[up.d]..row_ptr[up.d + 1]];
+                relative.extend(rd[up.p1..].iter().map(|&g| local[g]));
+                updates.push(up);
+            }
             update_ptr.push(updates.len());
         }
         let mut inverse = vec![0; n];
@@ -227,9 +250,9 @@ impl SymbolicSymmetricLu {
             offset,
             update_ptr,
             updates,
+            relative,
             gather_ptr: Vec::new(),
             gather: Vec::new(),
-            entry_super: Vec::new(),
             flops: Vec::new(),
             total_flops: 0.0,
             len,
@@ -283,15 +306,17 @@ impl SymbolicSymmetricLu {
         for s in 0..ns {
             gather_ptr[s + 1] += gather_ptr[s];
         }
+        if u32::try_from(len).is_err() || u32::try_from(slot.len()).is_err() {
+            return Err(too_large("the factor's entries"));
+        }
         let mut next = gather_ptr.clone();
         let mut gather = vec![(0, 0); slot.len()];
         for (i, (&k, &s)) in slot.iter().zip(&entry_super).enumerate() {
-            gather[next[s]] = (i, k);
+            gather[next[s]] = (i as u32, k as u32);
             next[s] += 1;
         }
         analysis.gather_ptr = gather_ptr;
         analysis.gather = gather;
-        analysis.entry_super = entry_super;
         Ok(analysis)
     }
 
@@ -437,8 +462,6 @@ pub struct NumericSymmetricLu {
 /// What one thread of the factorization writes besides the factors.
 #[derive(Default)]
 struct Scratch {
-    /// Local row of each (permuted) unknown in the supernode being computed.
-    position: Vec<usize>,
     /// A descendant's update.
     product: Vec<f64>,
     /// The pivot test's scale per column of the supernode.
@@ -478,14 +501,18 @@ impl NumericSymmetricLu {
         self.dirty.clear();
         self.dirty.resize(ns, !partial);
         if partial {
-            // Compared and kept in one pass: `factored` holds `a` from here on, and a
-            // failure below leaves `factored_on` unset, so the next call is whole anyway.
-            for ((&new, old), &s) in a.iter().zip(&mut self.factored).zip(&sy.entry_super) {
-                if new.to_bits() != old.to_bits() {
-                    self.dirty[s] = true;
-                    *old = new;
-                }
+            // A supernode is dirty at its first changed entry: after a Newton step's new
+            // Jacobian that is each one's first, and only a re-solve's unchanged supernodes
+            // are read through. A failure below leaves `factored_on` unset, so the next
+            // call is whole anyway.
+            for s in 0..ns {
+                let entries = &sy.gather[sy.gather_ptr[s]..sy.gather_ptr[s + 1]];
+                let factored = &self.factored;
+                self.dirty[s] = entries
+                    .iter()
+                    .any(|&(i, _)| a[i as usize].to_bits() != factored[i as usize].to_bits());
             }
+            self.factored.copy_from_slice(a);
             for s in 0..ns {
                 if !self.dirty[s] {
                     let updates = &sy.updates[sy.update_ptr[s]..sy.update_ptr[s + 1]];
@@ -507,9 +534,6 @@ impl NumericSymmetricLu {
         self.flops_done += recomputed;
         let threads = self.threads.max(1);
         self.scratch.resize_with(threads, Scratch::default);
-        for scratch in &mut self.scratch {
-            scratch.position.resize(sy.n, 0);
-        }
         let split = match &sy.forest {
             Some(forest) if threads > 1 && recomputed >= PARALLEL_MIN_FLOPS => {
                 let work: Vec<f64> = (0..ns)
@@ -664,37 +688,34 @@ fn factor_supernode(
     base: usize,
     scratch: &mut Scratch,
 ) -> std::result::Result<(), PivotFailure> {
-    let (f, k, r, rows) = sy.panels(s);
+    let (f, k, r, _) = sy.panels(s);
     let m = k + r;
     values[sy.offset[s] - base..sy.offset[s + 1] - base].fill(0.0);
     for &(i, slot) in &sy.gather[sy.gather_ptr[s]..sy.gather_ptr[s + 1]] {
-        values[slot - base] = a[i];
-    }
-    for j in 0..k {
-        scratch.position[f + j] = j;
-    }
-    for (p, &g) in rows.iter().enumerate() {
-        scratch.position[g] = k + p;
+        values[slot as usize - base] = a[i as usize];
     }
     let (done, rest) = values.split_at_mut(sy.offset[s] - base);
     let (l_panel, rest) = rest.split_at_mut(m * k);
     let u_panel = &mut rest[..r * k];
     for up in &sy.updates[sy.update_ptr[s]..sy.update_ptr[s + 1]] {
-        let (_, kd, rd, rows_d) = sy.panels(up.d);
+        let (_, kd, rd, _) = sy.panels(up.d);
         let md = kd + rd;
         let at = sy.offset[up.d] - base;
         let ld = MatRef::from_column_major_slice(&done[at..at + md * kd], md, kd);
         let ud = MatRef::from_column_major_slice(&done[at + md * kd..][..rd * kd], rd, kd);
         let (nr, nc) = (rd - up.p1, up.p2 - up.p1);
+        // Local rows of d's rows p1..: the first nc are s's columns.
+        let local = &sy.relative[up.rel..up.rel + nr];
         // L: rows p1.. of d times U's columns p1..p2.
         let l_rows = ld.subrows(kd + up.p1, nr);
         let u_cols = ud.subrows(up.p1, nc);
         dense_product(&mut scratch.product, l_rows, u_cols, nr, nc);
-        for c in 0..nc {
-            let col = rows_d[up.p1 + c] - f;
+        for (c, &col) in local[..nc].iter().enumerate() {
+            let col = col as usize;
             let target = &mut l_panel[col * m..(col + 1) * m];
-            for (i, &g) in rows_d[up.p1..].iter().enumerate() {
-                target[scratch.position[g]] -= scratch.product[i + c * nr];
+            let product = &scratch.product[c * nr..(c + 1) * nr];
+            for (&row, &p) in local.iter().zip(product) {
+                target[row as usize] -= p;
             }
         }
         // U^T: rows p2.. of d's U^T panel times L's rows p1..p2.
@@ -703,11 +724,12 @@ fn factor_supernode(
             let u_rows = ud.subrows(up.p2, nu);
             let l_cols = ld.subrows(kd + up.p1, nc);
             dense_product(&mut scratch.product, u_rows, l_cols, nu, nc);
-            for c in 0..nc {
-                let col = rows_d[up.p1 + c] - f;
+            for (c, &col) in local[..nc].iter().enumerate() {
+                let col = col as usize;
                 let target = &mut u_panel[col * r..(col + 1) * r];
-                for (i, &g) in rows_d[up.p2..].iter().enumerate() {
-                    target[scratch.position[g] - k] -= scratch.product[i + c * nu];
+                let product = &scratch.product[c * nu..(c + 1) * nu];
+                for (&row, &p) in local[nc..].iter().zip(product) {
+                    target[row as usize - k] -= p;
                 }
             }
         }
@@ -716,14 +738,12 @@ fn factor_supernode(
     scratch.column_max.clear();
     for j in 0..k {
         // Column j of L from the diagonal down, row j of U right of the diagonal.
-        let column = l_panel[j * m + j..(j + 1) * m].iter();
-        let row = (j + 1..k).map(|c| &l_panel[c * m + j]);
-        let row_beyond = u_panel[j * r..(j + 1) * r].iter();
-        let max = column
-            .chain(row)
-            .chain(row_beyond)
-            .fold(0.0f64, |a, v| a.max(v.abs()));
-        scratch.column_max.push(max);
+        let row = (j + 1..k).map(|c| l_panel[c * m + j]);
+        let max = largest_magnitude(&l_panel[j * m + j..(j + 1) * m])
+            .max(largest_magnitude(&u_panel[j * r..(j + 1) * r]));
+        scratch
+            .column_max
+            .push(row.fold(max, |a, v| a.max(v.abs())));
     }
     let mut panel = MatMut::from_column_major_slice_mut(l_panel, m, k);
     let (mut diagonal, _, mut below, _) = panel.rb_mut().split_at_mut(k, k);
@@ -750,6 +770,24 @@ fn factor_supernode(
         solve_unit_lower_triangular_in_place(diagonal.rb(), ut.rb_mut().transpose_mut(), Par::Seq);
     }
     Ok(())
+}
+
+/// The largest `|v|` of `values` (0 for none), NaN entries passed over as `f64::max` does.
+/// Four running maxima, so that the loop is not one chain of dependent comparisons: the
+/// maximum does not depend on the order.
+fn largest_magnitude(values: &[f64]) -> f64 {
+    let mut lanes = [0.0f64; 4];
+    let mut chunks = values.chunks_exact(4);
+    for chunk in &mut chunks {
+        for (lane, v) in lanes.iter_mut().zip(chunk) {
+            *lane = lane.max(v.abs());
+        }
+    }
+    let tail = chunks
+        .remainder()
+        .iter()
+        .fold(0.0f64, |a, v| a.max(v.abs()));
+    lanes.iter().fold(tail, |a, &v| a.max(v))
 }
 
 /// `out (rows x cols, column-major) = a b^T` for `a` (rows x k) and `b` (cols x k). Small
