@@ -261,8 +261,9 @@ pub struct SymmetricLu {
     no_fallback: bool,
     /// Threads of the numeric factorization ([`LinearSolver::set_threads`]).
     threads: usize,
-    /// The backward-error check's `A x`, `b - A x` and row sums of `|A|`, kept between
-    /// calls.
+    /// The backward-error check's `A X` (every column), `A x` and `b - A x` (the column
+    /// checked) and row sums of `|A|`, kept between calls.
+    products: Vec<f64>,
     product: Vec<f64>,
     residual: Vec<f64>,
     row_sums: Vec<f64>,
@@ -300,27 +301,21 @@ impl SymmetricLu {
         }
         self.numeric.solve_in_place(symbolic, rhs, nrhs);
         let n = p.n;
-        // |A|_inf, from the row sums taken in the first product's pass over A.
-        let mut norm_a = None;
+        // A X for every column and |A|_inf (from the row sums) in one pass over A.
+        a.mul_columns_and_row_abs_sums(rhs, nrhs, &mut self.products, &mut self.row_sums);
+        let norm_a = self.row_sums.iter().copied().fold(0.0, f64::max);
         for c in 0..nrhs {
             let (x, b) = (&mut rhs[c * n..(c + 1) * n], &original[c * n..(c + 1) * n]);
+            self.product.clear();
+            self.product
+                .extend_from_slice(&self.products[c * n..(c + 1) * n]);
             let mut refined = false;
             loop {
-                let norm = match norm_a {
-                    Some(norm) => {
-                        a.mul_vec_into(x, &mut self.product);
-                        norm
-                    }
-                    None => {
-                        a.mul_vec_and_row_abs_sums(x, &mut self.product, &mut self.row_sums);
-                        *norm_a.insert(self.row_sums.iter().copied().fold(0.0, f64::max))
-                    }
-                };
                 let r = &mut self.residual;
                 r.clear();
                 r.extend(b.iter().zip(&self.product).map(|(b, y)| b - y));
                 let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                let scale = norm * inf(x) + inf(b);
+                let scale = norm_a * inf(x) + inf(b);
                 let error = inf(r);
                 if !(error.is_finite() && scale.is_finite()) {
                     return Ok(false);
@@ -334,6 +329,7 @@ impl SymmetricLu {
                 self.numeric.solve_in_place(symbolic, r, 1);
                 x.iter_mut().zip(r.iter()).for_each(|(x, d)| *x += d);
                 refined = true;
+                a.mul_vec_into(x, &mut self.product);
             }
         }
         Ok(true)
