@@ -94,7 +94,43 @@ impl FloorRow {
     }
 }
 
-/// Times the default solver and the floor on one system, `repeats` times each.
+/// A matrix `a` and its negation in turn, one per call: every value changes from one call to the
+/// next, so a solver that refactorizes only what changed (the default one, for status
+/// prediction's re-solves) factorizes the whole matrix on every timed call, as a Newton
+/// step's new Jacobian makes it. (Timed on the same values twice, the second call would
+/// recompute nothing.) The negation keeps every pivot's magnitude and the pattern.
+pub struct Alternating<'a> {
+    a: &'a SparseMatrix,
+    negated: SparseMatrix,
+    flip: bool,
+}
+
+impl<'a> Alternating<'a> {
+    pub fn new(a: &'a SparseMatrix) -> Self {
+        let negated = SparseMatrix {
+            pattern: a.pattern.clone(),
+            values: a.values.iter().map(|v| -v).collect(),
+        };
+        Alternating {
+            a,
+            negated,
+            flip: false,
+        }
+    }
+
+    /// The matrix of the next call: the negation, then `a`, and so on.
+    pub fn next_matrix(&mut self) -> &SparseMatrix {
+        self.flip = !self.flip;
+        if self.flip {
+            &self.negated
+        } else {
+            self.a
+        }
+    }
+}
+
+/// Times the default solver and the floor on one system, `repeats` times each, every
+/// call a whole factorization ([`alternating`]).
 pub fn measure(
     a: &SparseMatrix,
     rhs: &[f64],
@@ -103,10 +139,14 @@ pub fn measure(
 ) -> Result<FloorRow> {
     let mut solver = SymmetricLu::default();
     let mut x = rhs.to_vec();
+    let mut matrices = Alternating::new(a);
     let (new_wall_ms, new_cpu_ms) = time_ms(repeats, || {
         x.copy_from_slice(rhs);
-        solver.solve_bordered(a, &mut x, border)
+        solver.solve_bordered(matrices.next_matrix(), &mut x, border)
     })?;
+    // The last timed call may have solved the negated system.
+    x.copy_from_slice(rhs);
+    solver.solve_bordered(a, &mut x, border)?;
     let backward_error = if border.is_empty() {
         let norm_a = a.row_abs_sums().into_iter().fold(0.0, f64::max);
         let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -117,9 +157,10 @@ pub fn measure(
     };
     let symbolic = SymbolicSymmetricLu::new(&a.pattern)?;
     let mut numeric = NumericSymmetricLu::default();
+    let mut matrices = Alternating::new(a);
     let (_, factor_cpu_ms) = time_ms(repeats, || {
         numeric
-            .factorize(&symbolic, &a.values)
+            .factorize(&symbolic, &matrices.next_matrix().values)
             .map_err(|e| Error::LinearSolver(format!("{e:?}")))
     })?;
     let (floor_wall_ms, floor_cpu_ms, floor_entries) = cholesky_floor(&a.pattern, repeats, false)?;
@@ -251,6 +292,58 @@ mod tests {
             .collect();
         assert!((growth_exponent(&points) - 1.27).abs() < 1e-12);
         assert!(growth_exponent(&points[..1]).is_nan());
+    }
+
+    /// Timed calls on [`Alternating`] matrices factorize the whole matrix every time (the
+    /// recomputed flops equal a whole factorization's), where the same values twice would
+    /// recompute nothing on the second call: what made the timings of the factorization
+    /// measure a refactorization that found nothing changed.
+    #[test]
+    fn alternating_matrices_make_every_factorization_whole() {
+        let side = 30;
+        let n = side * side;
+        let mut entries = Vec::new();
+        for i in 0..n {
+            entries.push((i, i));
+            for d in [1, side] {
+                if i + d < n {
+                    entries.extend([(i, i + d), (i + d, i)]);
+                }
+            }
+        }
+        let p = Arc::new(SparsePattern::from_entries(n, entries));
+        let mut a = SparseMatrix::zeros(p.clone());
+        for c in 0..n {
+            for k in p.col_ptr[c]..p.col_ptr[c + 1] {
+                let r = p.row_idx[k];
+                a.values[k] = if r == c {
+                    6.0
+                } else {
+                    -1.0 - 0.1 * ((r + 2 * c) % 3) as f64
+                };
+            }
+        }
+        let symbolic = SymbolicSymmetricLu::new(&p).unwrap();
+        let mut same = NumericSymmetricLu::default();
+        same.factorize(&symbolic, &a.values).unwrap();
+        same.factorize(&symbolic, &a.values).unwrap();
+        assert!(
+            same.flops_done < 0.6 * same.flops_total,
+            "{}",
+            same.flops_done
+        );
+        let mut numeric = NumericSymmetricLu::default();
+        let mut matrices = Alternating::new(&a);
+        for _ in 0..4 {
+            numeric
+                .factorize(&symbolic, &matrices.next_matrix().values)
+                .unwrap();
+        }
+        assert_eq!(numeric.flops_done, numeric.flops_total);
+        assert_eq!(
+            matrices.next_matrix().values,
+            a.values.iter().map(|v| -v).collect::<Vec<_>>()
+        );
     }
 
     /// The floor's matrix is SPD on a 2D Laplacian-like pattern (the factorization
