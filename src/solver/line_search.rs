@@ -49,6 +49,7 @@ impl Simulation {
         alpha0: f64,
         weights: &[f64],
         accept_full: &mut dyn FnMut(&Evaluation) -> Result<bool>,
+        residual_first: bool,
         times: &mut PhaseTimes,
     ) -> Result<(Vec<f64>, Evaluation, usize)> {
         let trial_x =
@@ -66,7 +67,10 @@ impl Simulation {
             // The full step, usually accepted, is evaluated whole; a cut only for its
             // residual, and given its Jacobian once accepted (`complete`: the element
             // tangents, no second contact pass).
-            let evaluated = if cut == 0 {
+            // With `residual_first`, the full step too is evaluated for its residual only
+            // and returned without its Jacobian when accepted: the iterate it leads to is
+            // expected to converge, and then none is needed (Newton completes it if not).
+            let evaluated = if cut == 0 && !residual_first {
                 ctx.evaluate(&xn, times)
             } else {
                 ctx.evaluate_residual(&xn, times)
@@ -75,9 +79,17 @@ impl Simulation {
                 Ok(e) => {
                     let m = self.residual_record(&e, weights).1;
                     if m.is_finite() && m <= (1.0 - 1e-4 * alpha) * merit0 {
+                        if cut == 0 && residual_first {
+                            return Ok((xn, e, cut));
+                        }
                         let e = ctx.complete(&xn, e, times)?;
                         return Ok((xn, e, cut));
                     }
+                    // The contraction test solves with the trial's Jacobian.
+                    let e = match cut == 0 && residual_first && alpha0 == 1.0 && m.is_finite() {
+                        true => ctx.complete(&xn, e, times)?,
+                        false => e,
+                    };
                     if cut == 0 && alpha0 == 1.0 && m.is_finite() && accept_full(&e)? {
                         return Ok((xn, e, 0));
                     }

@@ -6,6 +6,7 @@ use super::assembly::{Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
 use super::cycling::{CyclingMonitor, CyclingNode};
 use super::force_control;
 use super::linear::LinearSolver;
+use super::model::SolverSettings;
 use super::pseudo_transient::PseudoTransient;
 use super::simulation::Simulation;
 use crate::contact::{ContactStatus, FrameUpdate};
@@ -518,6 +519,10 @@ impl Simulation {
                     cycling_note()
                 )));
             }
+            // An iterate evaluated for its residual only, expected to converge, that did not.
+            if !eval.has_jacobian() {
+                eval = ctx.complete(&x, eval, times)?;
+            }
             times.newton_steps += 1;
             let ts = Instant::now();
             let dx = match (next_step.take(), continuation.as_mut()) {
@@ -565,6 +570,7 @@ impl Simulation {
                     contraction_time += ts.elapsed().as_secs_f64();
                     Ok(contracted.is_some())
                 },
+                converges_next(&residuals, &settings, reference),
                 times,
             )?;
             times.factorization_and_solve += contraction_time;
@@ -618,6 +624,36 @@ impl Simulation {
             })
             .collect()
     }
+}
+
+/// How far below its tolerance Newton's quadratic model must put the next iterate's
+/// residuals for [`converges_next`] to expect convergence.
+const CONVERGENCE_MARGIN: f64 = 0.1;
+
+/// Whether the iterate after the last of `records` is expected to converge, so that it is
+/// evaluated for its residual first and its Jacobian computed only if it is needed after
+/// all (a converged iterate's Jacobian is never used: one element tangent pass per
+/// increment). Expected when the last iterate changed no contact status and no yielding
+/// point and was a whole step, and the quadratic model of Newton's local phase,
+/// `r_next = r^3 / r_prev^2` (`r = C r_prev^2`, the same `C` once more), puts both the
+/// force and the contact residual below [`CONVERGENCE_MARGIN`] of their tolerances. Only
+/// the cost depends on it: a residual-only evaluation completed afterwards equals a full
+/// one bit for bit (`IncrementContext::complete`), and a wrong guess costs one
+/// residual-only element pass.
+fn converges_next(records: &[IterationRecord], settings: &SolverSettings, reference: f64) -> bool {
+    let [.., before, last] = records else {
+        return false;
+    };
+    if last.status_changes != 0 || last.yield_changes != 0 || !last.full_step {
+        return false;
+    }
+    let below = |now: f64, before: f64, tolerance: f64| {
+        let limit = CONVERGENCE_MARGIN * tolerance;
+        now <= limit || (now < before && now.powi(3) <= limit * before * before)
+    };
+    let force_tolerance = (settings.force_rel_tol * reference).max(settings.force_abs_tol);
+    below(last.force, before.force, force_tolerance)
+        && below(last.contact, before.contact, settings.contact_tol)
 }
 
 /// How many contact pairs of `eval` have another status than in `previous` (none when
@@ -731,6 +767,115 @@ mod tests {
             !evaluated.trial_points.is_empty(),
             "a restore keeps no forces"
         );
+    }
+
+    /// A line search told to expect convergence (`residual_first`) evaluates the full
+    /// step for its residual only and returns it without a Jacobian; completed, that
+    /// evaluation is the plain line search's, bit for bit (residual, Jacobian, contact),
+    /// at the same iterate. Checked on the first Newton step of increments of the Hill48
+    /// strip pressed and dragged by a rough roller.
+    #[test]
+    fn a_residual_first_step_completed_is_the_plain_one() {
+        let drag = Schedule::new(vec![
+            (0.0, Vec3::zeros()),
+            (0.5, Vec3::new(0.0, 0.0, -0.05)),
+            (1.0, Vec3::new(1.0, 0.0, -0.05)),
+        ])
+        .unwrap();
+        let mut model = strip_under_roller(100.0, 2.0, drag, None);
+        model.settings.increments = 8;
+        let mut sim = Simulation::new(model).unwrap();
+        let mut times = PhaseTimes::default();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let mut without_jacobian = 0;
+        for _ in 0..5 {
+            sim.step().unwrap();
+            let t_next = sim.time + 0.125;
+            let ctx = sim.context(t_next, None);
+            let mut x = sim.x.clone();
+            let mut linear = crate::solver::linear::Solver::default();
+            sim.start_iterate(&ctx, t_next, &mut x, &mut linear, &mut times)
+                .unwrap();
+            let weights = vec![0.0; sim.dofs.n_dofs - 3 * sim.dofs.n_nodes];
+            // The first Newton steps of the increment, each searched both ways.
+            for _ in 0..3 {
+                let eval = ctx.evaluate(&x, &mut times).unwrap();
+                let dx = sim.newton_step(&eval, &mut linear).unwrap();
+                let merit = sim.residual_record(&eval, &weights).1;
+                let mut search = |residual_first: bool| {
+                    let mut never = |_: &Evaluation| Ok(false);
+                    sim.line_search(
+                        &ctx,
+                        &x,
+                        &dx,
+                        merit,
+                        1.0,
+                        &weights,
+                        &mut never,
+                        residual_first,
+                        &mut times,
+                    )
+                    .unwrap()
+                };
+                let (x_plain, plain, cuts_plain) = search(false);
+                let (x_first, first, cuts_first) = search(true);
+                assert_eq!(bits(&x_plain), bits(&x_first));
+                assert_eq!(cuts_plain, cuts_first);
+                assert!(plain.has_jacobian());
+                if cuts_first == 0 {
+                    assert!(!first.has_jacobian(), "an accepted full step was completed");
+                    without_jacobian += 1;
+                }
+                assert_eq!(bits(&plain.residual), bits(&first.residual));
+                let completed = ctx.complete(&x_first, first, &mut times).unwrap();
+                assert_eq!(
+                    bits(&plain.jacobian.values),
+                    bits(&completed.jacobian.values)
+                );
+                assert_eq!(plain.trial_points, completed.trial_points);
+                x = x_plain;
+            }
+        }
+        assert!(without_jacobian > 0, "no full step was accepted");
+    }
+
+    /// The quadratic model expects convergence in Newton's local phase only.
+    #[test]
+    fn convergence_is_expected_in_the_quadratic_phase_only() {
+        let settings = SolverSettings::default();
+        let reference = 1e3;
+        let tol = (settings.force_rel_tol * reference).max(settings.force_abs_tol);
+        let record = |force: f64, contact: f64| IterationRecord {
+            force_rel: force / reference,
+            force,
+            contact,
+            status_changes: 0,
+            yield_changes: 0,
+            full_step: true,
+            correction: 0.0,
+        };
+        let ctol = settings.contact_tol;
+        let quadratic = [record(1e3 * tol, 1e3 * ctol), record(tol, ctol)];
+        assert!(converges_next(&quadratic, &settings, reference));
+        // Linear convergence: the next residual stays near the tolerance.
+        let linear = [record(2.0 * tol, 2.0 * ctol), record(1.5 * tol, 1.5 * ctol)];
+        assert!(!converges_next(&linear, &settings, reference));
+        // The contact residual lags.
+        let lagging = [record(1e3 * tol, 2.0 * ctol), record(tol, 1.5 * ctol)];
+        assert!(!converges_next(&lagging, &settings, reference));
+        // A residual that grew.
+        let grew = [record(tol, ctol), record(2.0 * tol, 0.0)];
+        assert!(!converges_next(&grew, &settings, reference));
+        assert!(!converges_next(&quadratic[1..], &settings, reference));
+        let mut changed = quadratic;
+        changed[1].status_changes = 3;
+        assert!(!converges_next(&changed, &settings, reference));
+        let mut cut = quadratic;
+        cut[1].full_step = false;
+        assert!(!converges_next(&cut, &settings, reference));
+        let mut yielding = quadratic;
+        yielding[1].yield_changes = 1;
+        assert!(!converges_next(&yielding, &settings, reference));
     }
 
     #[test]
