@@ -705,14 +705,9 @@ mod tests {
     use crate::solver::test_models::strip_under_roller;
     use crate::tool::schedule::Schedule;
 
-    /// The extrapolation guard's reference without an element pass
-    /// (`Simulation::committed_residual`): after increments of a Hill48 strip (finite
-    /// strain, yielding) pressed (four increments) and dragged (two) by a rough roller, the
-    /// kept converged forces equal a fresh residual-only pass at the committed unknowns with
-    /// the next increment's tools to round-off (a zero increment from the committed state),
-    /// and so do the residuals; without kept forces (after a restore) the pass is run.
-    #[test]
-    fn the_guard_reference_from_kept_forces_is_a_fresh_pass() {
+    /// The Hill48 strip under a rough roller pressed (to t = 0.5) and dragged (to 1), in
+    /// 8 increments.
+    fn pressed_and_dragged_strip() -> Simulation {
         let drag = Schedule::new(vec![
             (0.0, Vec3::zeros()),
             (0.5, Vec3::new(0.0, 0.0, -0.05)),
@@ -721,7 +716,18 @@ mod tests {
         .unwrap();
         let mut model = strip_under_roller(100.0, 2.0, drag, None);
         model.settings.increments = 8;
-        let mut sim = Simulation::new(model).unwrap();
+        Simulation::new(model).unwrap()
+    }
+
+    /// The extrapolation guard's reference without an element pass
+    /// (`Simulation::committed_residual`): after increments of a Hill48 strip (finite
+    /// strain, yielding) pressed (four increments) and dragged (two) by a rough roller, the
+    /// kept converged forces equal a fresh residual-only pass at the committed unknowns with
+    /// the next increment's tools to round-off (a zero increment from the committed state),
+    /// and so do the residuals; without kept forces (after a restore) the pass is run.
+    #[test]
+    fn the_guard_reference_from_kept_forces_is_a_fresh_pass() {
+        let mut sim = pressed_and_dragged_strip();
         let mut times = PhaseTimes::default();
         for _ in 0..6 {
             sim.step().unwrap();
@@ -772,19 +778,11 @@ mod tests {
     /// A line search told to expect convergence (`residual_first`) evaluates the full
     /// step for its residual only and returns it without a Jacobian; completed, that
     /// evaluation is the plain line search's, bit for bit (residual, Jacobian, contact),
-    /// at the same iterate. Checked on the first Newton step of increments of the Hill48
-    /// strip pressed and dragged by a rough roller.
+    /// at the same iterate. Checked on the first three Newton steps of increments of the
+    /// Hill48 strip pressed and dragged by a rough roller.
     #[test]
     fn a_residual_first_step_completed_is_the_plain_one() {
-        let drag = Schedule::new(vec![
-            (0.0, Vec3::zeros()),
-            (0.5, Vec3::new(0.0, 0.0, -0.05)),
-            (1.0, Vec3::new(1.0, 0.0, -0.05)),
-        ])
-        .unwrap();
-        let mut model = strip_under_roller(100.0, 2.0, drag, None);
-        model.settings.increments = 8;
-        let mut sim = Simulation::new(model).unwrap();
+        let mut sim = pressed_and_dragged_strip();
         let mut times = PhaseTimes::default();
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         let mut without_jacobian = 0;
