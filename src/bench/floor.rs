@@ -94,8 +94,8 @@ impl FloorRow {
     }
 }
 
-/// A matrix `a` and its negation in turn, one per call: every value changes from one call to the
-/// next, so a solver that refactorizes only what changed (the default one, for status
+/// A matrix `a` and its negation in turn, one per call: every value changes from one call
+/// to the next, so a solver that refactorizes only what changed (the default one, for status
 /// prediction's re-solves) factorizes the whole matrix on every timed call, as a Newton
 /// step's new Jacobian makes it. (Timed on the same values twice, the second call would
 /// recompute nothing.) The negation keeps every pivot's magnitude and the pattern.
@@ -130,7 +130,7 @@ impl<'a> Alternating<'a> {
 }
 
 /// Times the default solver and the floor on one system, `repeats` times each, every
-/// call a whole factorization ([`alternating`]).
+/// call a whole factorization ([`Alternating`]).
 pub fn measure(
     a: &SparseMatrix,
     rhs: &[f64],

@@ -79,18 +79,20 @@ impl Simulation {
                 Ok(e) => {
                     let m = self.residual_record(&e, weights).1;
                     if m.is_finite() && m <= (1.0 - 1e-4 * alpha) * merit0 {
-                        if cut == 0 && residual_first {
-                            return Ok((xn, e, cut));
-                        }
-                        let e = ctx.complete(&xn, e, times)?;
+                        let e = match cut == 0 && residual_first {
+                            true => e,
+                            false => ctx.complete(&xn, e, times)?,
+                        };
                         return Ok((xn, e, cut));
                     }
-                    // The contraction test solves with the trial's Jacobian.
-                    let e = match cut == 0 && residual_first && alpha0 == 1.0 && m.is_finite() {
+                    // The contraction test solves with the trial's Jacobian (`complete`
+                    // returns a full evaluation as it is).
+                    let contraction = cut == 0 && alpha0 == 1.0 && m.is_finite();
+                    let e = match contraction {
                         true => ctx.complete(&xn, e, times)?,
                         false => e,
                     };
-                    if cut == 0 && alpha0 == 1.0 && m.is_finite() && accept_full(&e)? {
+                    if contraction && accept_full(&e)? {
                         return Ok((xn, e, 0));
                     }
                     if m.is_finite() && best.as_ref().is_none_or(|b| m < b.0) {

@@ -449,8 +449,7 @@ impl Simulation {
                     "non-finite residual at iteration {iterations}"
                 )));
             }
-            let force_ok = rec.force <= settings.force_rel_tol * reference
-                || rec.force <= settings.force_abs_tol;
+            let force_ok = rec.force <= force_tolerance(&settings, reference);
             // An element whose local solve stopped early (an inexact iterate, see
             // `LocalSolve`) keeps Newton going: the next, smaller step makes it exact, so a
             // converged state is always the tight local tolerance's.
@@ -626,6 +625,12 @@ impl Simulation {
     }
 }
 
+/// The force residual an iterate converges at: the relative tolerance of `reference`, or
+/// the absolute one, whichever is larger.
+fn force_tolerance(settings: &SolverSettings, reference: f64) -> f64 {
+    (settings.force_rel_tol * reference).max(settings.force_abs_tol)
+}
+
 /// How far below its tolerance Newton's quadratic model must put the next iterate's
 /// residuals for [`converges_next`] to expect convergence.
 const CONVERGENCE_MARGIN: f64 = 0.1;
@@ -651,9 +656,11 @@ fn converges_next(records: &[IterationRecord], settings: &SolverSettings, refere
         let limit = CONVERGENCE_MARGIN * tolerance;
         now <= limit || (now < before && now.powi(3) <= limit * before * before)
     };
-    let force_tolerance = (settings.force_rel_tol * reference).max(settings.force_abs_tol);
-    below(last.force, before.force, force_tolerance)
-        && below(last.contact, before.contact, settings.contact_tol)
+    below(
+        last.force,
+        before.force,
+        force_tolerance(settings, reference),
+    ) && below(last.contact, before.contact, settings.contact_tol)
 }
 
 /// How many contact pairs of `eval` have another status than in `previous` (none when
@@ -842,7 +849,7 @@ mod tests {
     fn convergence_is_expected_in_the_quadratic_phase_only() {
         let settings = SolverSettings::default();
         let reference = 1e3;
-        let tol = (settings.force_rel_tol * reference).max(settings.force_abs_tol);
+        let tol = force_tolerance(&settings, reference);
         let record = |force: f64, contact: f64| IterationRecord {
             force_rel: force / reference,
             force,

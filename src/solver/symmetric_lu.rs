@@ -1032,12 +1032,6 @@ mod tests {
         assert_eq!(kept.flops_done, before, "same values: nothing to recompute");
     }
 
-    /// After a refused pivot the kept factors are incomplete: the next call factorizes
-    /// everything.
-    /// The factorization on 2, 3 and 4 threads (disjoint subtrees at once, the top after
-    /// them) gives the sequential factors bit for bit, whole and partial, and so the same
-    /// solutions; a matrix large enough that the split runs (its recomputed flops above
-    /// `PARALLEL_MIN_FLOPS`), and one change of a few rows for the partial call.
     /// Several right-hand sides solved at once (two share each pass over the factor) give
     /// each column's lone solve bit for bit, also where a column's entry is zero at a
     /// supernode's column (that column skips the update alone) and for an odd count.
@@ -1080,6 +1074,10 @@ mod tests {
         }
     }
 
+    /// The factorization on 2, 3 and 4 threads (disjoint subtrees at once, the top after
+    /// them) gives the sequential factors bit for bit, whole and partial, and so the same
+    /// solutions; a matrix large enough that the split runs (its recomputed flops above
+    /// `PARALLEL_MIN_FLOPS`), and one change of a few rows for the partial call.
     #[test]
     fn threads_give_the_sequential_factors_bit_for_bit() {
         let a = random_matrix(6000, 41);
@@ -1169,6 +1167,8 @@ mod tests {
         assert_eq!(bits(&parallel.values), bits(&sequential.values));
     }
 
+    /// After a refused pivot the kept factors are incomplete: the next call factorizes
+    /// everything.
     #[test]
     fn a_refused_pivot_makes_the_next_factorization_whole() {
         let a = random_matrix(300, 13);
