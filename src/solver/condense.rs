@@ -155,6 +155,10 @@ pub struct Condenser {
     rows: Vec<Vec<(usize, usize)>>,
     /// Rows of eliminated nodes' local blocks (full index), to skip when copying.
     condensed_row: Vec<bool>,
+    /// Per full row, whether it has a column of an eliminated multiplier (a kept row
+    /// that substitutes one, see [`Self::walk`]): few rows do, and the others' reduced
+    /// right-hand side and dirtiness need no pass over their entries.
+    substitutes: Vec<bool>,
     /// Per full row, its entries that land in the reduced matrix (columns that are not
     /// eliminated multipliers), as (reduced column, value position) in `rows`' order: the
     /// contributions [`Self::add_local_row`] makes and the back-substitution's `N du`
@@ -328,6 +332,10 @@ impl Condenser {
             node_changed: Vec::new(),
             dirty: Vec::new(),
         };
+        let substitutes = rows
+            .iter()
+            .map(|row| row.iter().any(|&(c, _)| owner[c].is_some()))
+            .collect();
         let mut condenser = Condenser {
             nodes,
             coefficient_count,
@@ -335,6 +343,7 @@ impl Condenser {
             pattern,
             rows,
             condensed_row,
+            substitutes,
             owner,
             slots: Vec::new(),
             reduced_entries: Vec::new(),
@@ -514,9 +523,14 @@ impl Condenser {
             if self.condensed_row[row] {
                 continue;
             }
+            rhs[ri] = -residual[row];
+            // A row the sink keeps, without substitution: its right-hand side is all.
+            if !self.substitutes[row] && !sink.writes(segment) {
+                segment += 1;
+                continue;
+            }
             sink.begin_segment(segment);
             segment += 1;
-            rhs[ri] = -residual[row];
             for &(col, k) in &self.rows[row] {
                 if let Some(ci) = self.reduced_index[col] {
                     sink.add(ri, ci, j[k]);
@@ -579,10 +593,13 @@ impl Condenser {
         } else {
             kept.jacobian.clone_from(&j.values);
         }
-        // The first call, or every segment dirty (a Newton step's new Jacobian): one clear
-        // of the whole matrix instead of each segment's slots, the same sums (a reduced
-        // entry receives the contributions of one segment only, from zero either way).
-        let replay_all = !partial || kept.dirty.iter().all(|&d| d);
+        // The first call, or most segments dirty (a Newton step's new Jacobian: all but
+        // the rows a Dirichlet condition keeps as they are): one clear of the whole matrix
+        // and every segment replayed instead of each dirty segment's slots cleared one by
+        // one, the same sums (a reduced entry receives the contributions of one segment
+        // only, from zero either way, and a clean segment's inputs are unchanged).
+        let replay_all =
+            !partial || 2 * kept.dirty.iter().filter(|&&d| d).count() > kept.dirty.len();
         if replay_all {
             kept.matrix.values.fill(0.0);
         }
@@ -639,9 +656,10 @@ impl Condenser {
                 .iter()
                 .map(|&row| {
                     row_changed[row]
-                        || self.rows[row]
-                            .iter()
-                            .any(|&(col, _)| self.owner[col].is_some_and(|(e, _)| node_changed[e]))
+                        || (self.substitutes[row]
+                            && self.rows[row].iter().any(|&(col, _)| {
+                                self.owner[col].is_some_and(|(e, _)| node_changed[e])
+                            }))
                 })
                 .chain(node_changed.iter().copied()),
         );
@@ -738,6 +756,11 @@ trait Contributions {
     /// The contributions that follow, up to the next call, form segment `index`: one
     /// kept row, or one eliminated node's three condensed rows, in the walk's order.
     fn begin_segment(&mut self, _index: usize) {}
+    /// Whether segment `index` is to be written; one that is not may be left out of the
+    /// walk (no [`Self::begin_segment`], no contributions).
+    fn writes(&self, _index: usize) -> bool {
+        true
+    }
     fn add(&mut self, row: usize, col: usize, value: f64);
     /// `factor` times the Jacobian values of a local row's reduced `entries` ((reduced
     /// column, value position) pairs), added to reduced row `row` in their order.
@@ -790,6 +813,9 @@ struct Replay<'a> {
 }
 
 impl Contributions for Replay<'_> {
+    fn writes(&self, index: usize) -> bool {
+        self.dirty.is_none_or(|d| d[index])
+    }
     fn begin_segment(&mut self, index: usize) {
         self.next = self.segment_start[index];
         self.active = self.dirty.is_none_or(|d| d[index]);
