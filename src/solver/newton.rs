@@ -55,6 +55,22 @@ pub struct IterationRecord {
     pub correction: f64,
 }
 
+impl IterationRecord {
+    /// The residual norms of an iterate (force against `reference`), as a whole step with
+    /// no change and no correction yet: the Newton loop fills those in.
+    fn new(force: f64, contact: f64, reference: f64) -> Self {
+        IterationRecord {
+            force_rel: force / reference,
+            force,
+            contact,
+            status_changes: 0,
+            yield_changes: 0,
+            full_step: true,
+            correction: 0.0,
+        }
+    }
+}
+
 fn full_step_default() -> bool {
     true
 }
@@ -210,15 +226,7 @@ impl Simulation {
                 .sum::<f64>())
         .sqrt();
         (
-            IterationRecord {
-                force_rel: force / reference,
-                force,
-                contact,
-                status_changes: 0,
-                yield_changes: 0,
-                full_step: true,
-                correction: 0.0,
-            },
+            IterationRecord::new(force, contact, reference),
             merit,
             reference,
         )
@@ -726,6 +734,25 @@ mod tests {
         Simulation::new(model).unwrap()
     }
 
+    /// The next increment's (0.125 after the committed time) context, its start iterate
+    /// (predictor and prescribed values) and the solver that predicted it.
+    fn next_increment_start<'a>(
+        sim: &'a Simulation,
+        times: &mut PhaseTimes,
+    ) -> (
+        IncrementContext<'a>,
+        Vec<f64>,
+        crate::solver::linear::Solver,
+    ) {
+        let t_next = sim.time + 0.125;
+        let ctx = sim.context(t_next, None);
+        let mut x = sim.x.clone();
+        let mut linear = crate::solver::linear::Solver::default();
+        sim.start_iterate(&ctx, t_next, &mut x, &mut linear, times)
+            .unwrap();
+        (ctx, x, linear)
+    }
+
     /// The extrapolation guard's reference without an element pass
     /// (`Simulation::committed_residual`): after increments of a Hill48 strip (finite
     /// strain, yielding) pressed (four increments) and dragged (two) by a rough roller, the
@@ -738,12 +765,7 @@ mod tests {
         let mut times = PhaseTimes::default();
         for _ in 0..6 {
             sim.step().unwrap();
-            let t_next = sim.time + 0.125;
-            let ctx = sim.context(t_next, None);
-            let mut plain = sim.x.clone();
-            let mut linear = crate::solver::linear::Solver::default();
-            sim.start_iterate(&ctx, t_next, &mut plain, &mut linear, &mut times)
-                .unwrap();
+            let (ctx, plain, _) = next_increment_start(&sim, &mut times);
             let fresh = ctx.evaluate_residual(&plain, &mut times).unwrap();
             let kept = sim.committed_residual(&ctx, &plain, &mut times).unwrap();
             assert!(kept.trial_points.is_empty(), "the elements ran");
@@ -795,12 +817,7 @@ mod tests {
         let mut without_jacobian = 0;
         for _ in 0..5 {
             sim.step().unwrap();
-            let t_next = sim.time + 0.125;
-            let ctx = sim.context(t_next, None);
-            let mut x = sim.x.clone();
-            let mut linear = crate::solver::linear::Solver::default();
-            sim.start_iterate(&ctx, t_next, &mut x, &mut linear, &mut times)
-                .unwrap();
+            let (ctx, mut x, mut linear) = next_increment_start(&sim, &mut times);
             let weights = vec![0.0; sim.dofs.n_dofs - 3 * sim.dofs.n_nodes];
             // The first Newton steps of the increment, each searched both ways.
             for _ in 0..3 {
@@ -850,15 +867,7 @@ mod tests {
         let settings = SolverSettings::default();
         let reference = 1e3;
         let tol = force_tolerance(&settings, reference);
-        let record = |force: f64, contact: f64| IterationRecord {
-            force_rel: force / reference,
-            force,
-            contact,
-            status_changes: 0,
-            yield_changes: 0,
-            full_step: true,
-            correction: 0.0,
-        };
+        let record = |force: f64, contact: f64| IterationRecord::new(force, contact, reference);
         let ctol = settings.contact_tol;
         let quadratic = [record(1e3 * tol, 1e3 * ctol), record(tol, ctol)];
         assert!(converges_next(&quadratic, &settings, reference));
