@@ -818,7 +818,7 @@ impl Contributions for Replay<'_> {
     }
     fn begin_segment(&mut self, index: usize) {
         self.next = self.segment_start[index];
-        self.active = self.dirty.is_none_or(|d| d[index]);
+        self.active = self.writes(index);
         if self.active && self.dirty.is_some() {
             for &k in &self.slots[self.next..self.segment_start[index + 1]] {
                 self.values[k as usize] = 0.0;
