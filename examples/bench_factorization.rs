@@ -13,9 +13,9 @@
 use std::sync::Arc;
 use std::time::Instant;
 use tribo::bench::floor;
+use tribo::solver::linear::system_dump;
 use tribo::solver::linear::{FaerLu, LinearSolver, SymmetricLu};
 use tribo::solver::sparse::SparsePattern;
-use tribo::solver::system_dump;
 
 /// Mean wall and CPU milliseconds of `f` over `repeats` calls, after one untimed call.
 fn time(repeats: usize, mut f: impl FnMut()) -> (f64, f64) {

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 use tribo::bench::floor;
-use tribo::solver::system_dump;
+use tribo::solver::linear::system_dump;
 
 struct Options {
     sizes: Vec<(usize, usize)>,

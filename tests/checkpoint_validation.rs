@@ -6,7 +6,7 @@
 mod common;
 
 use serde_json::Value;
-use tribo::solver::checkpoint::Checkpoint;
+use tribo::solver::simulation::checkpoint::Checkpoint;
 use tribo::solver::Simulation;
 
 fn model() -> tribo::solver::Model {

@@ -4,7 +4,8 @@
 mod common;
 
 use tribo::contact::ContactStatus;
-use tribo::solver::linear::{FaerLu, LinearSolverKind, SymmetricLu};
+use tribo::solver::linear::{FaerLu, SymmetricLu};
+use tribo::solver::LinearSolverKind;
 use tribo::solver::Simulation;
 
 fn drag(eliminate: bool) -> Simulation {

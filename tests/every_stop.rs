@@ -10,7 +10,7 @@ mod common;
 use common::TestDir;
 use std::path::{Path, PathBuf};
 use tribo::script::{self, HostOptions};
-use tribo::solver::checkpoint::Checkpoint;
+use tribo::solver::simulation::checkpoint::Checkpoint;
 
 fn out_dir(name: &str) -> TestDir {
     let d = TestDir::new(&format!("tribo-stop-{}-{name}", std::process::id()));

@@ -8,7 +8,7 @@ use common::TestDir;
 use std::path::{Path, PathBuf};
 use tribo::output::read_vtu_point_field;
 use tribo::script::{self, HostOptions};
-use tribo::solver::checkpoint::Checkpoint;
+use tribo::solver::simulation::checkpoint::Checkpoint;
 use tribo::solver::{Simulation, StepMode};
 
 fn out_dir(name: &str) -> TestDir {

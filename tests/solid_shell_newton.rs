@@ -120,7 +120,7 @@ fn converged_states_are_those_of_the_tight_local_solve() {
 /// which shows the memory is what the checkpoint restores.
 #[test]
 fn a_restart_repeats_the_run_with_the_elements_memory() {
-    use tribo::solver::checkpoint::Checkpoint;
+    use tribo::solver::simulation::checkpoint::Checkpoint;
     let finish = |mut sim: Simulation| -> Vec<f64> {
         while !sim.is_finished() {
             sim.step().unwrap();

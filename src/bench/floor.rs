@@ -1,6 +1,6 @@
 //! The factorization floor and the cost growth of the linear solve: times the default
 //! solver (`SymmetricLu`, numeric factorization + solve after its symbolic analysis) on a
-//! system written by a real run (`TRIBO_DUMP_SYSTEM`, see `solver::system_dump`) against
+//! system written by a real run (`TRIBO_DUMP_SYSTEM`, see `solver::linear::system_dump`) against
 //! the floor, faer's supernodal Cholesky (AMD) of an SPD matrix with the pattern of
 //! `A + A^T`; and fits the growth `t = c n^p` over several sizes.
 //!
@@ -12,9 +12,9 @@
 //! dominant, so SPD): its factorization costs what any Cholesky of that structure costs,
 //! whatever the values. One thread (`Par::Seq`) throughout.
 
+use crate::solver::linear::symmetric_lu::{NumericSymmetricLu, SymbolicSymmetricLu};
 use crate::solver::linear::{LinearSolver, SymmetricLu};
 use crate::solver::sparse::{SparseMatrix, SparsePattern};
-use crate::solver::symmetric_lu::{NumericSymmetricLu, SymbolicSymmetricLu};
 use crate::{Error, Result};
 use std::sync::Arc;
 use std::time::Instant;
@@ -226,7 +226,9 @@ pub fn cholesky_floor(
     }
     let sym = SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
     let order = match (&p.groups, grouped) {
-        (Some(groups), true) => Some(crate::solver::symmetric_lu::grouped_order(&lower, groups)?),
+        (Some(groups), true) => Some(crate::solver::linear::symmetric_lu::grouped_order(
+            &lower, groups,
+        )?),
         _ => None,
     };
     let ordering = match &order {

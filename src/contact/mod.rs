@@ -29,29 +29,3 @@ pub enum FrameUpdate {
     /// tangent plane for the increment).
     Frozen,
 }
-
-/// Switches of the contact treatment that studies compare.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ContactSettings {
-    pub enforcement: Enforcement,
-    pub frame: FrameUpdate,
-    /// Include curvature (normal gradient) terms in the Jacobian.
-    pub curvature: bool,
-    /// Explicit (paper) or implicit (trapezoidal, in the Newton loop) friction update.
-    pub friction_update: FrictionUpdate,
-    /// The default augmentation parameter under the augmented Lagrangian as a fraction of
-    /// the membrane stiffness under each node (`solver::augmentation`).
-    pub r_fraction: f64,
-}
-
-impl Default for ContactSettings {
-    fn default() -> Self {
-        ContactSettings {
-            enforcement: Enforcement::AugmentedLagrangian,
-            frame: FrameUpdate::EveryIteration,
-            curvature: true,
-            friction_update: FrictionUpdate::Explicit,
-            r_fraction: crate::solver::augmentation::MEMBRANE_FRACTION,
-        }
-    }
-}

@@ -220,7 +220,7 @@ impl RunOutput {
     ) -> Result<std::path::PathBuf> {
         let path = self.folder.resolve_for_write(relative)?;
         let mut checkpoint =
-            crate::solver::checkpoint::Checkpoint::of(sim, self.frame_times.clone());
+            crate::solver::simulation::checkpoint::Checkpoint::of(sim, self.frame_times.clone());
         checkpoint.script = script.clone();
         let json = checkpoint.to_json()?;
         super::write_atomic(&path, json.as_bytes())?;

@@ -7,7 +7,7 @@ use crate::contact::{Enforcement, FrameUpdate};
 use crate::contact::{FrictionInput, FrictionLaw};
 use crate::mesh::Mesh;
 use crate::output::{Cadence, Configuration, OutputOptions, RunOutput, Units};
-use crate::solver::checkpoint::Checkpoint;
+use crate::solver::simulation::checkpoint::Checkpoint;
 use crate::solver::{AntiCycling, IncrementReport, Model, Simulation, SolverSettings, StepMode};
 use crate::tool::Tool;
 use crate::Error;
@@ -870,8 +870,8 @@ fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptR
             }
             "linear_solver" => {
                 let name = v.clone().into_string().unwrap_or_default();
-                s.linear_solver = crate::solver::linear::LinearSolverKind::from_name(&name)
-                    .or_else(runtime_error)?
+                s.linear_solver =
+                    crate::solver::LinearSolverKind::from_name(&name).or_else(runtime_error)?
             }
             "kinematics" => {
                 let name = v.clone().into_string().unwrap_or_default();

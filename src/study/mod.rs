@@ -24,8 +24,8 @@ pub mod square_cup;
 pub mod stability;
 pub mod work_precision;
 
-use crate::contact::ContactSettings;
 use crate::solver::AntiCycling;
+use crate::solver::ContactSettings;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

@@ -50,10 +50,10 @@
 //! index of every contribution, in a fixed order), so that no entry is searched for; the
 //! factorization shrinks by the number of eliminated multipliers.
 
-use super::assembly::DofMap;
-use super::linear::LinearSolver;
-use super::model::Model;
-use super::sparse::{SparseMatrix, SparsePattern};
+use crate::solver::assembly::DofMap;
+use crate::solver::linear::LinearSolver;
+use crate::solver::model::Model;
+use crate::solver::sparse::{SparseMatrix, SparsePattern};
 use crate::Result;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};

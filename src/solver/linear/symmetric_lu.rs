@@ -32,7 +32,7 @@
 //! only, so disjoint subtrees of the elimination tree are factorized at once (each a
 //! contiguous range of supernodes, hence of the value array, cut apart without sharing),
 //! one thread per bin of subtrees of about equal recomputed flops
-//! ([`super::subtree_split`]), and the supernodes above them (the root separators) after
+//! ([`crate::solver::linear::subtree_split`]), and the supernodes above them (the root separators) after
 //! them on one thread. Each supernode is computed by the same operations whatever thread
 //! runs it: the factors are bit for bit the sequential ones. Where two bins meet refused
 //! pivots, the one of least column is reported (the sequential order may stop at another
@@ -41,10 +41,11 @@
 //! Without pivoting, a tiny pivot would spoil the factors: every diagonal pivot is checked
 //! against the largest entry of its column of `L` and row of `U` before elimination
 //! (`|u_jj| > 1e-10 max`), and the caller checks the backward error of the solution (see
-//! [`super::linear::SymmetricLu`]), falling back to a pivoting LU when either fails.
+//! [`SymmetricLu`]), falling back to a pivoting LU when either fails.
 
-use super::sparse::SparsePattern;
 use super::subtree_split::Forest;
+use super::{check_system, solve_bordered_in, BorderedSystem, Factorization, FaerLu, LinearSolver};
+use crate::solver::sparse::{SparseMatrix, SparsePattern};
 use crate::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::matmul::matmul;
@@ -488,7 +489,7 @@ impl NumericSymmetricLu {
     /// ancestors in the elimination tree). The others' panels depend on unchanged entries
     /// only, so the factors are the ones a full factorization gives, bit for bit. A
     /// re-solve that changes the rows of a few contact nodes (status prediction,
-    /// [`super::status_prediction`]) then pays for their paths to the root only.
+    /// [`crate::solver::newton::status_prediction`]) then pays for their paths to the root only.
     pub fn factorize(
         &mut self,
         symbolic: &SymbolicSymmetricLu,
@@ -627,7 +628,7 @@ impl NumericSymmetricLu {
         let ns = sy.begin.len() - 1;
         // Each column's operations are those of a solve of it alone, in the same order;
         // two columns at a time share each pass over the factor's panels (the bordered
-        // solve's second column, `super::linear::BorderedSystem`).
+        // solve's second column, `crate::solver::linear::BorderedSystem`).
         // L y = P b.
         for s in 0..ns {
             let (f, k, r, rows) = sy.panels(s);
@@ -891,11 +892,187 @@ fn lu_no_pivoting(mut a: MatMut<'_, f64>) {
     lu_no_pivoting(a22);
 }
 
+// The solver behind `LinearSolver`: the factors above with their checks and fallback.
+
+/// Backward error above which a solution without pivoting is refined once, and after the
+/// refinement handed to the pivoting LU: `|b - A x|_inf / (|A|_inf |x|_inf + |b|_inf)`.
+/// A stable factorization gives about n eps = 1e-16..1e-11 in the worst case bound, far
+/// less in practice; a bad pivot order gives orders of magnitude more.
+pub const BACKWARD_ERROR_TOLERANCE: f64 = 1e-12;
+
+/// Sparse LU without pivoting on the symmetric structure of `A + A^T` (AMD order,
+/// supernodal; see [`crate::solver::linear::symmetric_lu`]), for structurally symmetric systems with safe
+/// diagonal pivots like the condensed contact system. Every pivot is checked, and every
+/// solution's backward error (one step of iterative refinement allowed); when either fails,
+/// that call is solved by faer's pivoting LU instead, so robustness is the pivoting LU's.
+#[derive(Default)]
+pub struct SymmetricLu {
+    symbolic: Option<SymbolicSymmetricLu>,
+    numeric: NumericSymmetricLu,
+    fallback: FaerLu,
+    border: Option<Box<BorderedSystem<SymmetricLu>>>,
+    /// Number of symbolic analyses done (a pattern change triggers a new one).
+    pub symbolic_count: usize,
+    /// Calls solved by the pivoting LU because a pivot or the backward error failed.
+    pub fallback_count: usize,
+    /// Consecutive failures; after [`GIVE_UP_AFTER`] of them the next [`SKIP_CALLS`] calls
+    /// go straight to the pivoting LU (a system without safe pivots, such as the mixed
+    /// system with every multiplier kept, then costs one factorization per call, not two).
+    failures_in_a_row: usize,
+    skip: usize,
+    /// Refused systems fail instead of going to the pivoting LU
+    /// ([`LinearSolver::set_pivoting_fallback`]).
+    no_fallback: bool,
+    /// Threads of the numeric factorization ([`LinearSolver::set_threads`]).
+    threads: usize,
+    /// The backward-error check's `A X` (every column), `A x` and `b - A x` (the column
+    /// checked) and row sums of `|A|`, kept between calls.
+    products: Vec<f64>,
+    product: Vec<f64>,
+    residual: Vec<f64>,
+    row_sums: Vec<f64>,
+}
+
+/// See [`SymmetricLu::failures_in_a_row`].
+const GIVE_UP_AFTER: usize = 3;
+const SKIP_CALLS: usize = 50;
+
+impl SymmetricLu {
+    /// Stored entries of L and U (dense supernodal panels) of the last analysis.
+    pub fn factor_len(&self) -> Option<usize> {
+        self.symbolic.as_ref().map(|s| s.factor_len())
+    }
+
+    /// Factorizes and solves without pivoting; `Ok(false)` when a pivot or the backward
+    /// error is refused (then `rhs` is garbage).
+    fn try_without_pivoting(
+        &mut self,
+        a: &SparseMatrix,
+        rhs: &mut [f64],
+        nrhs: usize,
+        original: &[f64],
+    ) -> Result<bool> {
+        let p = &a.pattern;
+        let reuse = matches!(&self.symbolic, Some(s) if Arc::ptr_eq(s.pattern(), p) || **s.pattern() == **p);
+        if !reuse {
+            self.symbolic = Some(SymbolicSymmetricLu::new(p)?);
+            self.symbolic_count += 1;
+        }
+        let symbolic = self.symbolic.as_ref().expect("set above");
+        self.numeric.set_threads(self.threads);
+        if self.numeric.factorize(symbolic, &a.values).is_err() {
+            return Ok(false);
+        }
+        self.numeric.solve_in_place(symbolic, rhs, nrhs);
+        let n = p.n;
+        // A X for every column and |A|_inf (from the row sums) in one pass over A.
+        a.mul_columns_and_row_abs_sums(rhs, nrhs, &mut self.products, &mut self.row_sums);
+        let norm_a = self.row_sums.iter().copied().fold(0.0, f64::max);
+        for c in 0..nrhs {
+            let (x, b) = (&mut rhs[c * n..(c + 1) * n], &original[c * n..(c + 1) * n]);
+            self.product.clear();
+            self.product
+                .extend_from_slice(&self.products[c * n..(c + 1) * n]);
+            let mut refined = false;
+            loop {
+                let r = &mut self.residual;
+                r.clear();
+                r.extend(b.iter().zip(&self.product).map(|(b, y)| b - y));
+                let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let scale = norm_a * inf(x) + inf(b);
+                let error = inf(r);
+                if !(error.is_finite() && scale.is_finite()) {
+                    return Ok(false);
+                }
+                if error <= BACKWARD_ERROR_TOLERANCE * scale {
+                    break;
+                }
+                if refined {
+                    return Ok(false);
+                }
+                self.numeric.solve_in_place(symbolic, r, 1);
+                x.iter_mut().zip(r.iter()).for_each(|(x, d)| *x += d);
+                refined = true;
+                a.mul_vec_into(x, &mut self.product);
+            }
+        }
+        Ok(true)
+    }
+}
+
+impl Factorization for SymmetricLu {
+    fn symbolic_count(&self) -> usize {
+        self.symbolic_count + self.fallback.symbolic_count
+    }
+
+    fn factor_and_solve(&mut self, a: &SparseMatrix, rhs: &mut [f64], nrhs: usize) -> Result<()> {
+        check_system(a, rhs, nrhs)?;
+        let original = rhs.to_vec();
+        if self.no_fallback {
+            return match self.try_without_pivoting(a, rhs, nrhs, &original)? {
+                true => Ok(()),
+                false => Err(Error::LinearSolver(
+                    "a pivot or the backward error was refused (no pivoting fallback)".into(),
+                )),
+            };
+        }
+        if self.skip > 0 {
+            self.skip -= 1;
+        } else if self.try_without_pivoting(a, rhs, nrhs, &original)? {
+            self.failures_in_a_row = 0;
+            return Ok(());
+        } else {
+            self.failures_in_a_row += 1;
+            if self.failures_in_a_row >= GIVE_UP_AFTER {
+                self.failures_in_a_row = 0;
+                self.skip = SKIP_CALLS;
+            }
+        }
+        self.fallback_count += 1;
+        rhs.copy_from_slice(&original);
+        self.fallback.factor_and_solve(a, rhs, nrhs)
+    }
+}
+
+impl LinearSolver for SymmetricLu {
+    fn solve_bordered(&mut self, a: &SparseMatrix, b: &mut [f64], border: &[usize]) -> Result<()> {
+        if border.is_empty() {
+            return self.factor_and_solve(a, b, 1);
+        }
+        let (no_fallback, threads) = (self.no_fallback, self.threads);
+        self.symbolic_count += solve_bordered_in(&mut self.border, a, b, border, |inner| {
+            inner.no_fallback = no_fallback;
+            inner.threads = threads;
+        })?;
+        Ok(())
+    }
+
+    fn symbolic_analyses(&self) -> usize {
+        Factorization::symbolic_count(self)
+    }
+
+    fn set_pivoting_fallback(&mut self, allowed: bool) {
+        self.no_fallback = !allowed;
+    }
+
+    fn set_threads(&mut self, threads: usize) {
+        self.threads = threads;
+    }
+
+    fn split_factorizations(&self) -> usize {
+        self.numeric.split_calls
+            + self
+                .border
+                .as_ref()
+                .map_or(0, |b| b.inner.split_factorizations())
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::super::linear::{FaerLu, LinearSolver, SymmetricLu};
-    use super::super::sparse::{SparseMatrix, SparsePattern};
     use super::{NumericSymmetricLu, SymbolicSymmetricLu};
+    use crate::solver::linear::{FaerLu, LinearSolver, SymmetricLu};
+    use crate::solver::sparse::{SparseMatrix, SparsePattern};
     use std::sync::Arc;
 
     /// A small deterministic generator (no test depends on a crate's random stream).

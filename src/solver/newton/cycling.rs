@@ -17,8 +17,8 @@
 //! which the free law alone decides. `Damp` halves the Newton update while a node cycles
 //! instead.
 
-use super::step_control::AntiCycling;
 use crate::contact::ContactStatus;
+use crate::solver::settings::AntiCycling;
 
 /// Per (tool, candidate) status history of the current increment.
 #[derive(Clone, Debug)]

@@ -15,11 +15,11 @@
 //! `float_roundtrip` parser, so every f64 is restored bit for bit and a restarted run
 //! repeats the uninterrupted one exactly.
 
-use super::energy::{EnergyBalance, EnergyMemory};
-use super::simulation::{IncrementReport, Simulation};
-use super::step_control::StepController;
 use crate::contact::ContactNodeState;
 use crate::material::PointState;
+use crate::solver::simulation::energy::{EnergyBalance, EnergyMemory};
+use crate::solver::simulation::step_control::StepController;
+use crate::solver::simulation::{IncrementReport, Simulation};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -45,7 +45,7 @@ pub struct SavedState {
     #[serde(default)]
     pub last_step: Option<(f64, Vec<f64>)>,
     /// What the elements remembered at the committed state (the solid-shell's last
-    /// linearisation; [`super::assembly::ElementMemory`]), so that a restarted run
+    /// linearisation; [`crate::solver::assembly::ElementMemory`]), so that a restarted run
     /// predicts its next local solves as the uninterrupted one does. Unset entries are NaN,
     /// written as JSON `null`. Absent from older checkpoints (read as empty: the next
     /// increment's first local solves start cold).

@@ -27,9 +27,9 @@
 //!
 //! Cost per iterate: that of a plain Newton iterate plus one pass over the diagonal.
 
-use super::assembly::Evaluation;
-use super::linear::LinearSolver;
-use super::simulation::Simulation;
+use crate::solver::assembly::Evaluation;
+use crate::solver::linear::LinearSolver;
+use crate::solver::simulation::Simulation;
 use crate::Result;
 
 /// The shift of the first iterate, as a fraction of each displacement row's diagonal.

@@ -1,7 +1,7 @@
 //! Backtracking line search on the merit function of the Newton iteration.
 
-use super::assembly::{Evaluation, IncrementContext, PhaseTimes};
-use super::simulation::Simulation;
+use crate::solver::assembly::{Evaluation, IncrementContext, PhaseTimes};
+use crate::solver::simulation::Simulation;
 use crate::{Error, Result};
 
 /// Halvings of the line search (smallest step 1/16 of the Newton step).

@@ -3,20 +3,28 @@
 //! (halving the increment) on failure. Nothing committed is ever lost: a failed increment
 //! leaves the last converged state untouched.
 
-use super::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
-use super::checkpoint::SavedState;
-use super::condense::Condenser;
-use super::cycling::CyclingNode;
-use super::energy::{EnergyBalance, EnergyMemory};
-use super::force_control;
-use super::linear::{LinearSolver, Solver};
-use super::model::Model;
-use super::newton::{IterationRecord, Trial};
-use super::sparse::SparsePattern;
-use super::step_control::{schedule_stops, IncrementMeasures, Limit, StepController};
+pub mod checkpoint;
+pub mod energy;
+pub mod kinematics_check;
+pub mod step_control;
+pub mod stepping;
+
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
 use crate::geometry::Vec3;
 use crate::material::PointState;
+use crate::solver::assembly::force_control;
+use crate::solver::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use crate::solver::linear::condense::Condenser;
+use crate::solver::linear::{LinearSolver, Solver};
+use crate::solver::model::Model;
+use crate::solver::newton::cycling::CyclingNode;
+use crate::solver::newton::{IterationRecord, Trial};
+use crate::solver::simulation::checkpoint::SavedState;
+use crate::solver::simulation::energy::{EnergyBalance, EnergyMemory};
+use crate::solver::simulation::step_control::{
+    schedule_stops, IncrementMeasures, Limit, StepController,
+};
+use crate::solver::sparse::SparsePattern;
 use crate::{Error, Result};
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -80,7 +88,7 @@ pub struct Simulation {
     pub(super) linear: Solver,
     /// What the elements remembered at the last converged iterate (their linearisation
     /// there), where every attempt of the next increment starts
-    /// ([`super::assembly::ElementMemory`]); empty before the first increment.
+    /// ([`crate::solver::assembly::ElementMemory`]); empty before the first increment.
     pub(super) committed_memory: Vec<f64>,
     /// The elements' internal forces at the committed state (the converged evaluation's),
     /// so that the extrapolation guard's evaluation at the committed unknowns needs no
@@ -141,7 +149,7 @@ impl Simulation {
         }
         force_control::check(&model)?;
         let dofs = DofMap::new(&model);
-        let groups = super::condense::elimination_groups(&model, &dofs);
+        let groups = crate::solver::linear::condense::elimination_groups(&model, &dofs);
         let pattern = Arc::new(dofs.pattern(&model).with_groups(groups));
         let mut is_fixed = vec![false; dofs.n_dofs];
         for bc in &model.dirichlet {
@@ -393,7 +401,7 @@ impl Simulation {
         let kinematics_warning = (self.model.settings.kinematics
             == crate::element::StrainTheory::Small)
             .then(|| {
-                super::kinematics_check::small_strain_warning(
+                crate::solver::simulation::kinematics_check::small_strain_warning(
                     &self.points,
                     &trial.eval.trial_points,
                     self.points.len() / self.model.mesh.hexes.len().max(1),
@@ -690,7 +698,7 @@ fn cycling_warning(
     model: &Model,
     cycling: &[CyclingNode],
     increment: usize,
-    treatment: super::step_control::AntiCycling,
+    treatment: crate::solver::settings::AntiCycling,
 ) -> String {
     const SHOWN: usize = 5;
     let nodes: Vec<String> = cycling
@@ -718,7 +726,7 @@ fn cycling_warning(
             ""
         },
         match treatment {
-            super::step_control::AntiCycling::Off => ", or anti_cycling: \"freeze\"",
+            crate::solver::settings::AntiCycling::Off => ", or anti_cycling: \"freeze\"",
             _ => "",
         }
     )

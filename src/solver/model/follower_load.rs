@@ -23,7 +23,7 @@ use crate::mesh::Mesh;
 use crate::tool::ScalarSchedule;
 use crate::{Error, Result};
 
-use super::model::Model;
+use crate::solver::model::Model;
 
 /// Gauss abscissa of the 2 x 2 face rule (weights 1).
 const G: f64 = 0.577_350_269_189_625_8;

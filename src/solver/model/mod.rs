@@ -1,10 +1,13 @@
 //! The scene to simulate: body, boundary conditions, loads, tools and solver settings.
 //! A `Model` holds no solution; see [`super::Simulation`] for the evolving state.
 
-use crate::contact::ContactSettings;
+pub mod augmentation;
+pub mod follower_load;
+
 use crate::geometry::Vec3;
 use crate::material::Material;
 use crate::mesh::Mesh;
+use crate::solver::settings::SolverSettings;
 use crate::tool::schedule::ScalarSchedule;
 use crate::tool::Tool;
 use crate::{Error, Result};
@@ -47,99 +50,6 @@ pub struct ToolContact {
     pub r_default: bool,
 }
 
-/// Status-prediction re-solves per Newton step by default: 8. They take 42-50 % fewer
-/// iterations over the whole 25 x 25 x 1 square cups (on the paper cup's first 3 mm: 43
-/// against 129), which then meet issue 14's cup targets under the default budget (the plain
-/// Newton does not finish the paper cup under it), at 0.86-0.87 times the plain Newton's
-/// CPU (docs/convergence.md). The blocker of earlier sessions, a frictional first contact
-/// converging to another of its states (the cylindrical cup's first increment), came from
-/// pivoting solves of nearly singular predicted systems, which re-solves no longer do. Cost
-/// where prediction fails: an attempt that does not converge with it is tried again
-/// plainly before a cutback (the U-channel scene takes 2.6-2.9 times the plain CPU, and
-/// stays under 25 iterations per increment where the plain Newton took 26 and 30).
-pub const DEFAULT_STATUS_PREDICTION: usize = 8;
-
-/// Newton and stepping settings.
-#[derive(Clone, Debug)]
-pub struct SolverSettings {
-    pub max_iterations: usize,
-    /// Force residual tolerance relative to the norm of internal forces and reactions.
-    pub force_rel_tol: f64,
-    /// Absolute floor for the force residual (force units).
-    pub force_abs_tol: f64,
-    /// Contact residual tolerance (length units: constraint violation).
-    pub contact_tol: f64,
-    /// End of pseudo-time.
-    pub end_time: f64,
-    /// Number of equal increments to reach `end_time`.
-    pub increments: usize,
-    /// How many times an increment may be halved after a failed Newton solve.
-    pub max_cutbacks: usize,
-    pub contact: ContactSettings,
-    /// Eliminate the multipliers of single-pair, unconstrained contact nodes before the
-    /// linear solve (same Newton iterates, smaller factorization; see `condense`).
-    pub eliminate_multipliers: bool,
-    /// The sparse factorization of each Newton step (see `linear`).
-    pub linear_solver: super::linear::LinearSolverKind,
-    /// Small strain (B-bar hexahedra, the default) or finite strain (total-Lagrangian
-    /// F-bar hexahedra, Lagrangian log-strain material update).
-    pub kinematics: crate::element::StrainTheory,
-    /// F-bar volumetric treatment of the finite-strain hexahedron (default on; off gives
-    /// the fully integrated element, which locks: for verification only).
-    pub fbar: bool,
-    /// The hexahedron of the strain theory or the solid-shell (`element::solid_shell`).
-    pub element: crate::element::ElementKind,
-    /// Gauss points through the thickness of the solid-shell.
-    pub thickness_points: usize,
-    /// Increment control, line search, anti-cycling and rollback depth.
-    pub stepping: super::step_control::StepSettings,
-    /// Start each increment's Newton iteration from the last increment's change of the
-    /// displacements, scaled to the new step (off: from the committed state).
-    pub extrapolate: bool,
-    /// Re-solves of each Newton step with the contact nodes that the step carries across a
-    /// status boundary linearised on the status they are heading into (0: off; see
-    /// `status_prediction`).
-    pub status_prediction: usize,
-    /// Threads evaluating elements and factorizing (0: as many as the machine has cores).
-    /// The results do not depend on it: elements are scattered into the global system in
-    /// element order, and each supernode of the factorization is computed by the same
-    /// operations whatever thread runs it (`symmetric_lu`, "Threads").
-    pub threads: usize,
-}
-
-/// Newton iterations an attempt may take before it fails (and the increment is retried or
-/// cut back): 25. With the default r a tenth of the membrane stiffness (`augmentation`), an
-/// increment that has not converged in 25 iterations does better halved: on the U-channel
-/// (tests/scenes) a budget of 30 let two increments take 26 iterations and changed nothing
-/// else that matters (8 and 7 cutbacks either way, about the same CPU), and the 25 x 25 x 1
-/// cups never take more than 22 (docs/convergence.md).
-pub const DEFAULT_MAX_ITERATIONS: usize = 25;
-
-impl Default for SolverSettings {
-    fn default() -> Self {
-        SolverSettings {
-            max_iterations: DEFAULT_MAX_ITERATIONS,
-            force_rel_tol: 1e-9,
-            force_abs_tol: 1e-9,
-            contact_tol: 1e-9,
-            end_time: 1.0,
-            increments: 10,
-            max_cutbacks: 4,
-            contact: ContactSettings::default(),
-            eliminate_multipliers: true,
-            linear_solver: Default::default(),
-            kinematics: crate::element::StrainTheory::Small,
-            fbar: true,
-            element: crate::element::ElementKind::Hexahedron,
-            thickness_points: crate::element::solid_shell::DEFAULT_THICKNESS_POINTS,
-            stepping: Default::default(),
-            extrapolate: true,
-            status_prediction: DEFAULT_STATUS_PREDICTION,
-            threads: 0,
-        }
-    }
-}
-
 /// The whole scene.
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -148,7 +58,7 @@ pub struct Model {
     pub dirichlet: Vec<Dirichlet>,
     pub loads: Vec<NodalLoad>,
     /// Loads that turn with the surface (`solver::follower_load`).
-    pub follower_loads: Vec<super::follower_load::FollowerTraction>,
+    pub follower_loads: Vec<crate::solver::model::follower_load::FollowerTraction>,
     pub contacts: Vec<ToolContact>,
     pub settings: SolverSettings,
 }
@@ -263,9 +173,9 @@ impl Model {
             Some(r) => vec![r; candidates.len()],
             // The membrane stiffness of the layer under each node, scaled to the enforcement
             // when the simulation starts (`settle_default_r`; the settings may still change).
-            None => super::augmentation::membrane_stiffness(
+            None => crate::solver::model::augmentation::membrane_stiffness(
                 &self.mesh,
-                super::augmentation::young_modulus(&self.material.elastic_tangent()),
+                crate::solver::model::augmentation::young_modulus(&self.material.elastic_tangent()),
                 &candidates,
             )?,
         };

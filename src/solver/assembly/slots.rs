@@ -32,9 +32,9 @@
 //! candidate: three equilibrium rows, three multiplier rows), its force row (per candidate:
 //! three multiplier columns) and its diagonal `(s, s)` (the approach equation).
 
-use super::model::Model;
-use super::sparse::SparsePattern;
 use crate::element::hex8::DOFS;
+use crate::solver::model::Model;
+use crate::solver::sparse::SparsePattern;
 
 /// Entries of one element stiffness.
 pub const ELEMENT_ENTRIES: usize = DOFS * DOFS;

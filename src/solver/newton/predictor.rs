@@ -3,10 +3,10 @@
 //! spread over the body by one tangent solve) and the seating of force-controlled tools
 //! that touch nothing at the first iterate.
 
-use super::assembly::{Evaluation, IncrementContext, PhaseTimes};
-use super::force_control;
-use super::linear::LinearSolver;
-use super::simulation::Simulation;
+use crate::solver::assembly::force_control;
+use crate::solver::assembly::{Evaluation, IncrementContext, PhaseTimes};
+use crate::solver::linear::LinearSolver;
+use crate::solver::simulation::Simulation;
 use crate::Result;
 use std::time::Instant;
 

@@ -25,11 +25,12 @@
 //! without them keeps its increments bit for bit: they start only where the run would
 //! have stopped.
 
-use super::assembly::PhaseTimes;
-use super::linear::LinearSolver;
-use super::newton::{Attempt, Trial};
-use super::simulation::{IncrementReport, Simulation};
-use super::step_control::{IncrementMeasures, Limit, StepController, StepMode};
+use crate::solver::assembly::PhaseTimes;
+use crate::solver::linear::LinearSolver;
+use crate::solver::newton::{Attempt, Trial};
+use crate::solver::settings::StepMode;
+use crate::solver::simulation::step_control::{IncrementMeasures, Limit, StepController};
+use crate::solver::simulation::{IncrementReport, Simulation};
 use crate::{Error, Result};
 
 /// Newton iterations of the plain retry of an increment that failed with status
@@ -268,7 +269,7 @@ impl Simulation {
                     report.limit = verdict.limit;
                     let (ratio, which) = measures.ratio(&step);
                     if ratio < 1.0 {
-                        report.warnings.push(super::step_control::limit_warning(
+                        report.warnings.push(crate::solver::simulation::step_control::limit_warning(
                             which,
                             1.0 / ratio,
                             dt_min,
@@ -354,7 +355,9 @@ impl Simulation {
     fn try_increment(&mut self, t_new: f64, attempt: Attempt) -> Result<Trial> {
         // The factorization cache lives outside `self` while the context borrows it.
         let mut linear = std::mem::take(&mut self.linear);
-        linear.set_threads(super::assembly::worker_threads(self.model.settings.threads));
+        linear.set_threads(crate::solver::assembly::worker_threads(
+            self.model.settings.threads,
+        ));
         let (prediction, budget) = match attempt {
             Attempt::Regular => (
                 self.model.settings.status_prediction,

@@ -36,11 +36,11 @@
 //! terms cancel in `R1 - r R2` because `dF_suppl/ds = (dF_equi/ds) / r`), and the force row
 //! receives that substitution.
 
-use super::assembly::DofMap;
-use super::model::Model;
-use super::slots::ForceControlSlots;
 use crate::contact::{Enforcement, NodalContact};
 use crate::geometry::{Projection, Vec3};
+use crate::solver::assembly::slots::ForceControlSlots;
+use crate::solver::assembly::DofMap;
+use crate::solver::model::Model;
 use crate::tool::Pose;
 use crate::{Error, Result};
 

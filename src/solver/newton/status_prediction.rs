@@ -23,16 +23,16 @@
 //! [`IncrementContext::relinearised`]) and one linear solve, whose factorization
 //! recomputes only the supernodes that the changed nodes' rows reach (their paths to the
 //! root of the elimination tree: 58-67 % of a whole factorization's flops on the 25 x 25 x 1
-//! cup, [`super::symmetric_lu::NumericSymmetricLu::factorize`]); the prediction itself is
+//! cup, [`crate::solver::linear::symmetric_lu::NumericSymmetricLu::factorize`]); the prediction itself is
 //! O(1) per contact pair.
 
-use super::assembly::{DofMap, Evaluation, IncrementContext, PhaseTimes};
-use super::linear::LinearSolver;
-use super::model::Model;
-use super::newton::norm;
-use super::simulation::Simulation;
 use crate::contact::ContactStatus;
 use crate::geometry::Vec3;
+use crate::solver::assembly::{DofMap, Evaluation, IncrementContext, PhaseTimes};
+use crate::solver::linear::LinearSolver;
+use crate::solver::model::Model;
+use crate::solver::newton::norm;
+use crate::solver::simulation::Simulation;
 use crate::Result;
 
 /// How much longer than the plain step (displacement parts) a re-solved step may be. On

@@ -2,14 +2,20 @@
 //! merit function, the divergence guard, anti-cycling (freeze and release) and the linear
 //! solve of each iteration.
 
-use super::assembly::{Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
-use super::cycling::{CyclingMonitor, CyclingNode};
-use super::force_control;
-use super::linear::LinearSolver;
-use super::model::SolverSettings;
-use super::pseudo_transient::PseudoTransient;
-use super::simulation::Simulation;
+pub mod cycling;
+pub mod line_search;
+pub mod predictor;
+pub mod pseudo_transient;
+pub mod status_prediction;
+
 use crate::contact::{ContactStatus, FrameUpdate};
+use crate::solver::assembly::force_control;
+use crate::solver::assembly::{Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use crate::solver::linear::LinearSolver;
+use crate::solver::newton::cycling::{CyclingMonitor, CyclingNode};
+use crate::solver::newton::pseudo_transient::PseudoTransient;
+use crate::solver::settings::SolverSettings;
+use crate::solver::simulation::Simulation;
 use crate::{Error, Result};
 use std::time::Instant;
 

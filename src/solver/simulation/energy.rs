@@ -2,10 +2,10 @@
 //! trapezoidal rule against the stored elastic energy and the plastic and frictional
 //! dissipation.
 
-use super::assembly::Evaluation;
-use super::force_control;
-use super::simulation::Simulation;
 use crate::geometry::Vec3;
+use crate::solver::assembly::force_control;
+use crate::solver::assembly::Evaluation;
+use crate::solver::simulation::Simulation;
 
 impl Simulation {
     /// Updates the energy balance with one converged increment: trapezoidal rule for the

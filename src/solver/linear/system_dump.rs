@@ -7,7 +7,7 @@
 //! Format, little-endian u64 / f64: `n, nnz, n_border, has_groups`, then `col_ptr (n + 1)`,
 //! `row_idx (nnz)`, `values (nnz)`, `rhs (n)`, `border (n_border)`, `groups (n, if any)`.
 
-use super::sparse::{SparseMatrix, SparsePattern};
+use crate::solver::sparse::{SparseMatrix, SparsePattern};
 use crate::{Error, Result};
 use std::io::{Read, Write};
 use std::path::Path;

@@ -46,9 +46,9 @@ pub fn young_modulus(c: &Tangent) -> f64 {
     mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu)
 }
 
-/// The fraction of the membrane stiffness under a node that is its default r under the
-/// augmented Lagrangian (module doc).
-pub const MEMBRANE_FRACTION: f64 = 0.1;
+/// The default fraction of the membrane stiffness under a node that is its r under the
+/// augmented Lagrangian, the setting `r_fraction` (module doc); kept with the settings.
+pub use crate::solver::settings::MEMBRANE_FRACTION;
 
 /// The membrane stiffness `k_a` per candidate (same order as `candidates`), for Young's
 /// modulus `young`: the default penalty stiffness, and `1 / MEMBRANE_FRACTION` times the
