@@ -1,7 +1,7 @@
 //! Backtracking line search on the merit function of the Newton iteration.
 
 use crate::solver::assembly::{Evaluation, IncrementContext, PhaseTimes};
-use crate::solver::simulation::Simulation;
+use crate::solver::newton::Newton;
 use crate::{Error, Result};
 
 /// Halvings of the line search (smallest step 1/16 of the Newton step).
@@ -17,7 +17,7 @@ const DEEP_CUTS: usize = 12;
 /// cuts at milder rises and cost the coarse cups iterations; at 10 they keep theirs.
 const KINK_MERIT_RISE: f64 = 10.0;
 
-impl Simulation {
+impl Newton<'_> {
     /// Backtracking (Armijo) line search on the merit function |R|: the step `alpha dx` with
     /// the first alpha in `alpha0, alpha0/2, ...` (down to `alpha0/16`) that reduces the merit
     /// by the factor `1 - 1e-4 alpha`; failing that, the trial with the smallest merit. A

@@ -1,6 +1,13 @@
 //! The generalised Newton method on (u, lambda) for one increment: residual norms and the
 //! merit function, the divergence guard, anti-cycling (freeze and release) and the linear
 //! solve of each iteration.
+//!
+//! [`Newton`] is a value that borrows, immutably, the parts of the committed state an
+//! increment reads (its fields are the whole list), so a trial cannot touch committed
+//! state: it returns a [`Trial`] that the simulation commits or drops. The wing's other
+//! files add the steps of one iteration to it: the predictor (`predictor`), the line
+//! search (`line_search`), status prediction (`status_prediction`), anti-cycling
+//! (`cycling`) and pseudo-transient continuation (`pseudo_transient`).
 
 pub mod cycling;
 pub mod line_search;
@@ -8,15 +15,23 @@ pub mod predictor;
 pub mod pseudo_transient;
 pub mod status_prediction;
 
+use crate::contact::ContactNodeState;
 use crate::contact::{ContactStatus, FrameUpdate};
+use crate::geometry::Vec3;
+use crate::interrupt::Interrupt;
+use crate::material::PointState;
 use crate::solver::assembly::force_control;
+use crate::solver::assembly::DofMap;
 use crate::solver::assembly::{Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use crate::solver::linear::condense::Condenser;
 use crate::solver::linear::LinearSolver;
+use crate::solver::model::Model;
 use crate::solver::newton::cycling::{CyclingMonitor, CyclingNode};
 use crate::solver::newton::pseudo_transient::PseudoTransient;
 use crate::solver::settings::SolverSettings;
-use crate::solver::simulation::Simulation;
+use crate::solver::sparse::SparsePattern;
 use crate::{Error, Result};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Consecutive merit increases that count as divergence.
@@ -32,6 +47,80 @@ const FORCE_GROWTH_LIMIT: f64 = 3.0;
 /// How much larger than the unextrapolated start's merit the extrapolated start's may be
 /// before it is dropped (see `newton`).
 const EXTRAPOLATION_GUARD: f64 = 10.0;
+
+/// One increment's Newton solve, borrowing what it reads of the model and of the committed
+/// state (built by `Simulation::newton`). Everything an attempt changes lives in its own
+/// copies (the iterate, the [`IncrementContext`]) and leaves in the [`Trial`].
+pub struct Newton<'a> {
+    pub(crate) model: &'a Model,
+    pub(crate) dofs: &'a DofMap,
+    pub(crate) pattern: &'a Arc<SparsePattern>,
+    /// Whether each unknown is prescribed (a Dirichlet row).
+    pub(crate) is_fixed: &'a [bool],
+    /// The multiplier elimination, when there is one.
+    pub(crate) condenser: Option<&'a Condenser>,
+    /// The committed time and unknowns [u, lambda].
+    pub(crate) time: f64,
+    pub(crate) x: &'a [f64],
+    /// Committed material point states, contact states per tool and candidate, and what
+    /// the elements remembered at the last converged iterate (`ElementMemory`).
+    pub(crate) points: &'a [PointState],
+    pub(crate) contact: &'a [Vec<ContactNodeState>],
+    pub(crate) committed_memory: &'a [f64],
+    /// The committed state's element forces, when kept (`committed_residual`).
+    pub(crate) committed_forces: Option<&'a [f64]>,
+    /// The last converged increment (dt, change of the displacements), for the predictor.
+    pub(crate) last_step: Option<&'a (f64, Vec<f64>)>,
+    /// Stop request polled between iterations.
+    pub(crate) interrupt: &'a Interrupt,
+}
+
+impl<'a> Newton<'a> {
+    /// The evaluation context of an increment to `time` against the committed state.
+    pub(crate) fn context(
+        &self,
+        time: f64,
+        frozen: Option<Vec<Vec<Option<FrozenFrame>>>>,
+    ) -> IncrementContext<'a> {
+        IncrementContext {
+            model: self.model,
+            dofs: self.dofs,
+            pattern: self.pattern.clone(),
+            time,
+            poses: self
+                .model
+                .contacts
+                .iter()
+                .map(|c| c.tool.pose(time))
+                .collect(),
+            committed_points: self.points,
+            committed_contact: self.contact,
+            frozen,
+            is_fixed: self.is_fixed,
+            forced: None,
+            element_memory: self.committed_memory.to_vec().into(),
+            keep_element_jacobian: self.model.settings.status_prediction > 0,
+            element_buffers: Default::default(),
+        }
+    }
+
+    /// `Error::Interrupted` once a stop was requested; the committed state stays.
+    pub(crate) fn check_interrupt(&self) -> Result<()> {
+        if self.interrupt.is_raised() {
+            return Err(Error::Interrupted(format!(
+                "{}; the increment from t = {} was abandoned",
+                self.interrupt.reason(),
+                self.time
+            )));
+        }
+        Ok(())
+    }
+
+    /// Committed displacement of a node.
+    fn displacement(&self, node: usize) -> Vec3 {
+        Vec3::new(self.x[3 * node], self.x[3 * node + 1], self.x[3 * node + 2])
+    }
+}
 
 /// One Newton iteration's residual norms.
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
@@ -144,7 +233,7 @@ fn cycling_note(nodes: &[usize]) -> String {
     }
 }
 
-impl Simulation {
+impl Newton<'_> {
     /// Solves J dx = -R, through the condensed system when multipliers are eliminated.
     pub fn newton_step(
         &self,
@@ -311,7 +400,7 @@ impl Simulation {
         let n_u = 3 * self.dofs.n_nodes;
         match &self.committed_forces {
             Some(f_int) if plain[..n_u] == self.x[..n_u] => {
-                ctx.residual_with_forces(plain, f_int.clone(), times)
+                ctx.residual_with_forces(plain, f_int.to_vec(), times)
             }
             _ => ctx.evaluate_residual(plain, times),
         }
@@ -322,7 +411,7 @@ impl Simulation {
     /// `max_iterations` iterations. A last-resort `attempt` runs without the divergence
     /// guard; [`Attempt::Continuation`] solves each step from a shifted Jacobian
     /// ([`PseudoTransient`]).
-    pub(super) fn newton(
+    pub(in crate::solver) fn solve(
         &self,
         t_new: f64,
         linear: &mut dyn LinearSolver,
@@ -336,7 +425,7 @@ impl Simulation {
         settings.status_prediction = prediction;
         settings.max_iterations = max_iterations;
         let step = &settings.stepping;
-        let mut x = self.x.clone();
+        let mut x = self.x.to_vec();
         let frozen = match settings.contact.frame {
             FrameUpdate::EveryIteration => None,
             FrameUpdate::Frozen => Some(self.frozen_frames(t_new)),
@@ -724,6 +813,7 @@ mod tests {
     use super::*;
     use crate::geometry::Vec3;
     use crate::solver::test_models::strip_under_roller;
+    use crate::solver::Simulation;
     use crate::tool::schedule::Schedule;
 
     /// The Hill48 strip under a rough roller pressed (to t = 0.5) and dragged (to 1), in
@@ -743,24 +833,25 @@ mod tests {
     /// The next increment's (0.125 after the committed time) context, its start iterate
     /// (predictor and prescribed values) and the solver that predicted it.
     fn next_increment_start<'a>(
-        sim: &'a Simulation,
+        newton: &Newton<'a>,
         times: &mut PhaseTimes,
     ) -> (
         IncrementContext<'a>,
         Vec<f64>,
         crate::solver::linear::Solver,
     ) {
-        let t_next = sim.time + 0.125;
-        let ctx = sim.context(t_next, None);
-        let mut x = sim.x.clone();
+        let t_next = newton.time + 0.125;
+        let ctx = newton.context(t_next, None);
+        let mut x = newton.x.to_vec();
         let mut linear = crate::solver::linear::Solver::default();
-        sim.start_iterate(&ctx, t_next, &mut x, &mut linear, times)
+        newton
+            .start_iterate(&ctx, t_next, &mut x, &mut linear, times)
             .unwrap();
         (ctx, x, linear)
     }
 
     /// The extrapolation guard's reference without an element pass
-    /// (`Simulation::committed_residual`): after increments of a Hill48 strip (finite
+    /// (`Newton::committed_residual`): after increments of a Hill48 strip (finite
     /// strain, yielding) pressed (four increments) and dragged (two) by a rough roller, the
     /// kept converged forces equal a fresh residual-only pass at the committed unknowns with
     /// the next increment's tools to round-off (a zero increment from the committed state),
@@ -771,9 +862,10 @@ mod tests {
         let mut times = PhaseTimes::default();
         for _ in 0..6 {
             sim.step().unwrap();
-            let (ctx, plain, _) = next_increment_start(&sim, &mut times);
+            let newton = sim.newton();
+            let (ctx, plain, _) = next_increment_start(&newton, &mut times);
             let fresh = ctx.evaluate_residual(&plain, &mut times).unwrap();
-            let kept = sim.committed_residual(&ctx, &plain, &mut times).unwrap();
+            let kept = newton.committed_residual(&ctx, &plain, &mut times).unwrap();
             assert!(kept.trial_points.is_empty(), "the elements ran");
             let scale = norm(&fresh.f_int);
             let force_gap = fresh
@@ -800,10 +892,11 @@ mod tests {
             "the strip did not yield"
         );
         sim.restore_state(sim.saved_state());
-        let t_next = sim.time + 0.125;
-        let ctx = sim.context(t_next, None);
-        let plain = sim.x.clone();
-        let evaluated = sim.committed_residual(&ctx, &plain, &mut times).unwrap();
+        let newton = sim.newton();
+        let t_next = newton.time + 0.125;
+        let ctx = newton.context(t_next, None);
+        let plain = newton.x.to_vec();
+        let evaluated = newton.committed_residual(&ctx, &plain, &mut times).unwrap();
         assert!(
             !evaluated.trial_points.is_empty(),
             "a restore keeps no forces"
@@ -823,27 +916,29 @@ mod tests {
         let mut without_jacobian = 0;
         for _ in 0..5 {
             sim.step().unwrap();
-            let (ctx, mut x, mut linear) = next_increment_start(&sim, &mut times);
+            let newton = sim.newton();
+            let (ctx, mut x, mut linear) = next_increment_start(&newton, &mut times);
             let weights = vec![0.0; sim.dofs.n_dofs - 3 * sim.dofs.n_nodes];
             // The first Newton steps of the increment, each searched both ways.
             for _ in 0..3 {
                 let eval = ctx.evaluate(&x, &mut times).unwrap();
-                let dx = sim.newton_step(&eval, &mut linear).unwrap();
-                let merit = sim.residual_record(&eval, &weights).1;
+                let dx = newton.newton_step(&eval, &mut linear).unwrap();
+                let merit = newton.residual_record(&eval, &weights).1;
                 let mut search = |residual_first: bool| {
                     let mut never = |_: &Evaluation| Ok(false);
-                    sim.line_search(
-                        &ctx,
-                        &x,
-                        &dx,
-                        merit,
-                        1.0,
-                        &weights,
-                        &mut never,
-                        residual_first,
-                        &mut times,
-                    )
-                    .unwrap()
+                    newton
+                        .line_search(
+                            &ctx,
+                            &x,
+                            &dx,
+                            merit,
+                            1.0,
+                            &weights,
+                            &mut never,
+                            residual_first,
+                            &mut times,
+                        )
+                        .unwrap()
                 };
                 let (x_plain, plain, cuts_plain) = search(false);
                 let (x_first, first, cuts_first) = search(true);

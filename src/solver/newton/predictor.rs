@@ -6,11 +6,11 @@
 use crate::solver::assembly::force_control;
 use crate::solver::assembly::{Evaluation, IncrementContext, PhaseTimes};
 use crate::solver::linear::LinearSolver;
-use crate::solver::simulation::Simulation;
+use crate::solver::newton::Newton;
 use crate::Result;
 use std::time::Instant;
 
-impl Simulation {
+impl Newton<'_> {
     /// The last increment's displacement change, scaled to this step, added to `x`: in
     /// forming the sheet keeps moving the way it moved, so the first iterate starts near the
     /// right contact statuses (from the committed state, Newton has to rediscover the whole

@@ -29,7 +29,7 @@
 
 use crate::solver::assembly::Evaluation;
 use crate::solver::linear::LinearSolver;
-use crate::solver::simulation::Simulation;
+use crate::solver::newton::Newton;
 use crate::Result;
 
 /// The shift of the first iterate, as a fraction of each displacement row's diagonal.
@@ -63,7 +63,7 @@ impl PseudoTransient {
     /// The correction from the Jacobian of `eval` with `sigma · |J_ii|` added to each
     /// displacement row's diagonal (`n_u` rows); `eval`'s Jacobian is left as it was.
     pub(super) fn step(
-        sim: &Simulation,
+        sim: &Newton<'_>,
         eval: &mut Evaluation,
         n_u: usize,
         sigma: f64,

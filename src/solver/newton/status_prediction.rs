@@ -32,7 +32,7 @@ use crate::solver::assembly::{DofMap, Evaluation, IncrementContext, PhaseTimes};
 use crate::solver::linear::LinearSolver;
 use crate::solver::model::Model;
 use crate::solver::newton::norm;
-use crate::solver::simulation::Simulation;
+use crate::solver::newton::Newton;
 use crate::Result;
 
 /// How much longer than the plain step (displacement parts) a re-solved step may be. On
@@ -147,7 +147,7 @@ pub fn prediction_rounds<S: PartialEq + Clone>(
     tried.pop().expect("the plain step is always there").1
 }
 
-impl Simulation {
+impl Newton<'_> {
     /// The Newton step `dx` solved at the evaluation `eval` of `x`, re-solved up to `rounds`
     /// times with the contact pairs whose predicted status differs from their status at `x`
     /// linearised on the predicted one (see the module doc and [`prediction_rounds`]); the

@@ -13,12 +13,12 @@ use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput
 use crate::geometry::Vec3;
 use crate::material::PointState;
 use crate::solver::assembly::force_control;
-use crate::solver::assembly::{DofMap, Evaluation, FrozenFrame, IncrementContext, PhaseTimes};
+use crate::solver::assembly::{DofMap, Evaluation, PhaseTimes};
 use crate::solver::linear::condense::Condenser;
 use crate::solver::linear::{LinearSolver, Solver};
 use crate::solver::model::Model;
 use crate::solver::newton::cycling::CyclingNode;
-use crate::solver::newton::{IterationRecord, Trial};
+use crate::solver::newton::{IterationRecord, Newton, Trial};
 use crate::solver::simulation::checkpoint::SavedState;
 use crate::solver::simulation::energy::{EnergyBalance, EnergyMemory};
 use crate::solver::simulation::step_control::{
@@ -305,31 +305,32 @@ impl Simulation {
         Ok(r)
     }
 
-    pub(super) fn context(
-        &self,
-        time: f64,
-        frozen: Option<Vec<Vec<Option<FrozenFrame>>>>,
-    ) -> IncrementContext<'_> {
-        IncrementContext {
+    /// The Newton solver of the next increment, borrowing the committed state.
+    pub(crate) fn newton(&self) -> Newton<'_> {
+        Newton {
             model: &self.model,
             dofs: &self.dofs,
-            pattern: self.pattern.clone(),
-            time,
-            poses: self
-                .model
-                .contacts
-                .iter()
-                .map(|c| c.tool.pose(time))
-                .collect(),
-            committed_points: &self.points,
-            committed_contact: &self.contact,
-            frozen,
+            pattern: &self.pattern,
             is_fixed: &self.is_fixed,
-            forced: None,
-            element_memory: self.committed_memory.clone().into(),
-            keep_element_jacobian: self.model.settings.status_prediction > 0,
-            element_buffers: Default::default(),
+            condenser: self.condenser.as_ref(),
+            time: self.time,
+            x: &self.x,
+            points: &self.points,
+            contact: &self.contact,
+            committed_memory: &self.committed_memory,
+            committed_forces: self.committed_forces.as_deref(),
+            last_step: self.last_step.as_ref(),
+            interrupt: &self.interrupt,
         }
+    }
+
+    /// Solves J dx = -R at the committed state's model (`Newton::newton_step`).
+    pub fn newton_step(
+        &self,
+        eval: &Evaluation,
+        linear: &mut dyn LinearSolver,
+    ) -> Result<Vec<f64>> {
+        self.newton().newton_step(eval, linear)
     }
 
     /// The multiplier elimination, when there is one.
@@ -361,7 +362,7 @@ impl Simulation {
     /// history (what Newton sees; used to check the Jacobian by finite differences).
     pub fn evaluate_at(&self, time: f64, x: &[f64]) -> Result<Evaluation> {
         let mut t = PhaseTimes::default();
-        self.context(time, None).evaluate(x, &mut t)
+        self.newton().context(time, None).evaluate(x, &mut t)
     }
 
     /// Connects a stop request: a raised flag abandons the increment under way at its next
@@ -372,14 +373,7 @@ impl Simulation {
     }
 
     pub(super) fn check_interrupt(&self) -> Result<()> {
-        if self.interrupt.is_raised() {
-            return Err(Error::Interrupted(format!(
-                "{}; the increment from t = {} was abandoned",
-                self.interrupt.reason(),
-                self.time
-            )));
-        }
-        Ok(())
+        self.newton().check_interrupt()
     }
 
     /// Commits a converged trial (keeping the state it replaces for `rollback`).

@@ -368,7 +368,9 @@ impl Simulation {
         // Every attempt's time is the run's: a failed one's is counted here, an accepted
         // one's (with a failed predicted attempt before its plain retry) when committed.
         let mut spent = PhaseTimes::default();
-        let mut outcome = self.newton(t_new, &mut linear, prediction, budget, attempt, &mut spent);
+        let mut outcome =
+            self.newton()
+                .solve(t_new, &mut linear, prediction, budget, attempt, &mut spent);
         // A re-solved step can lead far off where many nodes change status at once (no
         // merit check guards it, see `status_prediction`), and the increment then fails
         // where the plain Newton would not: it is tried once more, plainly, before any
@@ -377,7 +379,7 @@ impl Simulation {
         // Newton cannot converge either (it cycles on the solid-shell cup), a retry with
         // the whole budget cost more than the cutback it was meant to avoid.
         if prediction > 0 && matches!(&outcome, Err(e) if retryable(e)) {
-            outcome = self.newton(
+            outcome = self.newton().solve(
                 t_new,
                 &mut linear,
                 0,
