@@ -259,7 +259,7 @@ fn jacobian_matches_finite_differences_on_patch_tools() {
     }
 }
 
-/// The state of the coarse benchmark cup's linear tail (docs/convergence.md, "The linear
+/// The state of the coarse benchmark cup's linear tail (docs/convergence-log.md, "The linear
 /// tail of the coarse benchmark cup's first increment"): a node slipping on the flat holder
 /// with its tangential trial force only 3 % outside the Coulomb cone (r = 5.75e4 N/mm,
 /// mu = 0.162, sigma_n = -105.5 N, |sigma_t| = 17.6 N against mu |sigma_n| = 17.1 N).

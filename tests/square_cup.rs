@@ -350,7 +350,7 @@ const CONDENSED_BOUND: f64 = 1e-9;
 
 /// The script's default step follows the mesh: 0.5 mm of travel per increment on 25 x 25
 /// and coarser meshes (3 mm cells and up), a sixth of the in-plane cell on finer ones
-/// (docs/convergence.md, "Time step and mesh"). 30 x 30 cells are 2.5 mm, so 0.5 mm of
+/// (docs/convergence-log.md, "Time step and mesh"). 30 x 30 cells are 2.5 mm, so 0.5 mm of
 /// travel takes two increments of 0.25 mm; 8 x 8 cells keep 0.5 mm.
 #[test]
 fn the_default_step_follows_the_cell() {

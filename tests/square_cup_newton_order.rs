@@ -33,7 +33,7 @@
 //! Jacobian there matches central differences block by block and the Taylor remainder along
 //! each step is quadratic, but Newton's pre-asymptotic phase in the multiplier of a node
 //! pair slipping 3 % outside the Coulomb cone, whose slip direction turns 0.1 rad per step;
-//! docs/convergence.md). So the test holds what is true today and fails if Newton
+//! docs/convergence-log.md). So the test holds what is true today and fails if Newton
 //! turns into a fixed-point iteration broadly: a median >= 1.9 and at least 80 % of the
 //! measured increments >= 1.8 over both variants, with at least 5 measured per variant.
 

@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::time::Instant;
 
-/// Mesh of every run: 32 x 8 cells (0.5 mm), as in BENCHMARKS.md's drag.
+/// Mesh of every run: 32 x 8 cells (0.5 mm), as in docs/history/benchmarks.md's drag.
 const CELLS: usize = 32;
 const MAX_ITERATIONS: usize = 25;
 

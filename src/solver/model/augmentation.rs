@@ -25,12 +25,12 @@
 //! penetration `p / r`, it is `k_a` itself. Why a tenth: a tool pressing a sheet is resisted
 //! by the sheet's bending more than by its membrane, and the barely touching nodes of a
 //! sheet wrapping a radius flip their status on gaps of `lambda / r`. Measured
-//! (BENCHMARKS.md, "Default r a tenth of the membrane stiffness"): the U-channel
+//! (docs/history/benchmarks.md, "Default r a tenth of the membrane stiffness"): the U-channel
 //! (tests/scenes) is cut back 8 and 7 times instead of 30 and 34, the 25 x 25 x 1 cups take
 //! 304 and 436 Newton iterations instead of 432 and 522 with no cutback, at the same
 //! converged answers. The first default, the column stiffness `M A / h` (M the P-wave
 //! modulus), was about 200 times the present one on the cup's cells and made the
-//! active-set search oscillate (BENCHMARKS.md, issue 14).
+//! active-set search oscillate (docs/history/benchmarks.md, issue 14).
 
 use crate::element::{Element, Hex8};
 use crate::material::Tangent;
