@@ -1,4 +1,4 @@
-//! Rigid tools: a surface, its pose, and how the pose moves with pseudo-time (see DESIGN.md).
+//! Rigid tools: a surface, its pose, and how the pose moves with pseudo-time (see docs/architecture.md).
 
 pub mod force_control;
 pub mod pose;
