@@ -9,6 +9,7 @@
 # To compare against a commit: `git worktree add /tmp/before <commit>`, build it with
 # `cargo build --release` there, and pass /tmp/before/target/release/tribo as BEFORE_BIN.
 # Exit status 0 when every history is identical, 1 otherwise (the differing files named).
+# With REUSE_BEFORE=1, the BEFORE side's outputs already in WORK_DIR/before are reused.
 set -euo pipefail
 before=$(realpath "$1"); after=$(realpath "$2")
 work=${3:-$(mktemp -d)}
@@ -25,6 +26,9 @@ for case in "${cases[@]}"; do
   IFS='|' read -r name script sets <<<"$case"
   for side in before after; do
     bin=$before; [ "$side" = after ] && bin=$after
+    if [ "$side" = before ] && [ "${REUSE_BEFORE:-0}" = 1 ] && [ -d "$work/before/$name" ]; then
+      continue
+    fi
     out="$work/$side/$name"; rm -rf "$out"
     eval "\"$bin\" run \"$root/$script\" $sets --quiet --out \"$out\"" > "$work/$side-$name.log" 2>&1 \
       || { echo "$name: the $side run failed (log: $work/$side-$name.log)"; status=1; }

@@ -379,13 +379,16 @@ fn measure(
     if !output.status.success() {
         let stderr = String::from_utf8_lossy(&output.stderr);
         let tail: Vec<&str> = stderr.lines().rev().take(5).collect();
-        return Err(Error::NoConvergence(format!(
-            "bench case {} with {}: the run failed ({}): {}",
-            case.name,
-            binary.display(),
-            output.status,
-            tail.into_iter().rev().collect::<Vec<_>>().join(" | ")
-        )));
+        return Err(Error::no_convergence(
+            crate::error::Failure::Unrecoverable,
+            format!(
+                "bench case {} with {}: the run failed ({}): {}",
+                case.name,
+                binary.display(),
+                output.status,
+                tail.into_iter().rev().collect::<Vec<_>>().join(" | ")
+            ),
+        ));
     }
     let summary_path = out.join("summary.json");
     let text = std::fs::read_to_string(&summary_path).map_err(|e| Error::io(&summary_path, e))?;

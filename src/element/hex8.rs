@@ -903,7 +903,7 @@ pub(super) mod tests {
         let err = Hex8
             .evaluate(&x, &u, &states(), &mut trial, &m)
             .unwrap_err();
-        assert!(matches!(err, Error::NoConvergence(_)));
+        assert!(matches!(err, Error::NoConvergence { .. }));
         assert!(
             err.to_string()
                 .contains("integration point 0: non-finite strain"),

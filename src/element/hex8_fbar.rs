@@ -113,10 +113,10 @@ pub(super) fn inverse_transpose(f: &Mat3, what: impl Fn() -> String) -> Result<(
     let det = f.determinant();
     match f.try_inverse() {
         Some(inv) if det > 0.0 && det.is_finite() => Ok((inv.transpose(), det)),
-        _ => Err(Error::NoConvergence(format!(
-            "det F = {det} at {} (element turned inside out)",
-            what()
-        ))),
+        _ => Err(Error::no_convergence(
+            crate::error::Failure::Local,
+            format!("det F = {det} at {} (element turned inside out)", what()),
+        )),
     }
 }
 

@@ -257,7 +257,15 @@ pub(crate) fn prefix(err: Error, what: &str) -> Error {
         Error::Input(m) => Error::Input(format!("{what}: {m}")),
         Error::Script(m) => Error::Script(format!("{what}: {m}")),
         Error::LinearSolver(m) => Error::LinearSolver(format!("{what}: {m}")),
-        Error::NoConvergence(m) => Error::NoConvergence(format!("{what}: {m}")),
+        Error::NoConvergence {
+            kind,
+            cycling,
+            message,
+        } => Error::NoConvergence {
+            kind,
+            cycling,
+            message: format!("{what}: {message}"),
+        },
         other => other,
     }
 }

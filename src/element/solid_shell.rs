@@ -484,7 +484,10 @@ type LevelDerivatives = [[Vec3; NODES]; LOCATIONS];
 /// definite (an inverted material) or not finite.
 pub(super) fn cholesky_excess(a: &Mat3) -> Result<Mat3> {
     if !a.iter().all(|v| v.is_finite()) {
-        return Err(Error::NoConvergence("non-finite enhanced strain".into()));
+        return Err(Error::no_convergence(
+            crate::error::Failure::Local,
+            "non-finite enhanced strain",
+        ));
     }
     let mut h = Mat3::zeros();
     // Row i of R = I + h: R_ii = √(C_ii - Σ_{k<i} R_ki²), R_ij = (C_ij - Σ_{k<i} R_ki R_kj) / R_ii.
@@ -494,10 +497,13 @@ pub(super) fn cholesky_excess(a: &Mat3) -> Result<Mat3> {
             excess -= h[(k, i)] * h[(k, i)];
         }
         if excess.is_nan() || excess <= -1.0 {
-            return Err(Error::NoConvergence(format!(
-                "enhanced strain with a non-positive stretch {} (inverted material)",
-                1.0 + excess
-            )));
+            return Err(Error::no_convergence(
+                crate::error::Failure::Local,
+                format!(
+                    "enhanced strain with a non-positive stretch {} (inverted material)",
+                    1.0 + excess
+                ),
+            ));
         }
         let r = (1.0 + excess).sqrt();
         h[(i, i)] = excess / (1.0 + r);
@@ -523,14 +529,15 @@ pub(super) fn cholesky_excess(a: &Mat3) -> Result<Mat3> {
 /// iteration `X ← (X + X⁻ᵀ)/2`, quadratic, 3-5 steps from a near-rotation.
 pub(super) fn cauchy_stress(f: &Mat3, e: &Voigt, s: &Voigt) -> Result<Voigt> {
     let stretch = Mat3::identity() + cholesky_excess(&(strain_to_tensor(e) * 2.0))?;
-    let inverse = stretch
-        .try_inverse()
-        .ok_or_else(|| Error::NoConvergence("singular enhanced stretch".into()))?;
+    let inverse = stretch.try_inverse().ok_or_else(|| {
+        Error::no_convergence(crate::error::Failure::Local, "singular enhanced stretch")
+    })?;
     let mut q = f * inverse;
     for _ in 0..20 {
         let Some(inv) = q.try_inverse() else {
-            return Err(Error::NoConvergence(
-                "singular deformation gradient in the stress output".into(),
+            return Err(Error::no_convergence(
+                crate::error::Failure::Local,
+                "singular deformation gradient in the stress output",
             ));
         };
         let next = (q + inv.transpose()) * 0.5;
@@ -658,9 +665,12 @@ fn solve_enhanced<const C: usize>(
     for m in ne..ENHANCED_PARAMETERS {
         k_aa[(m, m)] = 1.0;
     }
-    k_aa.lu()
-        .solve(rhs)
-        .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))
+    k_aa.lu().solve(rhs).ok_or_else(|| {
+        Error::no_convergence(
+            crate::error::Failure::Local,
+            "singular enhanced-strain stiffness",
+        )
+    })
 }
 
 /// The through-thickness rule of `n` points, computed once per `n`.
@@ -921,10 +931,13 @@ impl SolidShell {
                 return Ok((step, solve));
             }
             if newton_steps >= max_steps || !size.is_finite() {
-                return Err(Error::NoConvergence(format!(
-                    "enhanced-strain parameters not converged after {newton_steps} local \
+                return Err(Error::no_convergence(
+                    crate::error::Failure::Local,
+                    format!(
+                        "enhanced-strain parameters not converged after {newton_steps} local \
                      iterations (last step {size:e})"
-                )));
+                    ),
+                ));
             }
             last = Some((*alpha, step, norm, 1.0));
             newton_steps += 1;

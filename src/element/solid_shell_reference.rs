@@ -48,17 +48,23 @@ struct Location {
 /// `U - I` for `C = I + a` (`a = 2E`), without round-off against `I`.
 fn stretch_minus_identity(a: &Mat3) -> Result<Mat3> {
     if !a.iter().all(|v| v.is_finite()) {
-        return Err(Error::NoConvergence("non-finite enhanced strain".into()));
+        return Err(Error::no_convergence(
+            crate::error::Failure::Local,
+            "non-finite enhanced strain",
+        ));
     }
     let eig = SymmetricEigen::new((a + a.transpose()) * 0.5);
     let mut d = Vec3::zeros();
     for i in 0..3 {
         let mu = eig.eigenvalues[i];
         if mu.is_nan() || mu <= -1.0 {
-            return Err(Error::NoConvergence(format!(
-                "enhanced strain with a stretch eigenvalue {} (inverted material)",
-                1.0 + mu
-            )));
+            return Err(Error::no_convergence(
+                crate::error::Failure::Local,
+                format!(
+                    "enhanced strain with a stretch eigenvalue {} (inverted material)",
+                    1.0 + mu
+                ),
+            ));
         }
         d[i] = mu / (1.0 + (1.0 + mu).sqrt());
     }
@@ -332,11 +338,12 @@ pub fn evaluate_into(
             stresses[p] = s;
             tangents[p] = c;
         }
-        let step = k_aa
-            .clone()
-            .lu()
-            .solve(&r_a)
-            .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))?;
+        let step = k_aa.clone().lu().solve(&r_a).ok_or_else(|| {
+            Error::no_convergence(
+                crate::error::Failure::Local,
+                "singular enhanced-strain stiffness",
+            )
+        })?;
         let size = step.amax();
         let scale = strain_scale.max(alpha.iter().fold(0.0, |m, a| m.max(a.abs())));
         // Converged, or stalled at round-off (the step no longer shrinks).
@@ -346,10 +353,13 @@ pub fn evaluate_into(
             break;
         }
         if iteration >= MAX_LOCAL_ITERATIONS || !size.is_finite() {
-            return Err(Error::NoConvergence(format!(
-                "enhanced-strain parameters not converged after {iteration} local \
+            return Err(Error::no_convergence(
+                crate::error::Failure::Local,
+                format!(
+                    "enhanced-strain parameters not converged after {iteration} local \
                  iterations (last step {size:e})"
-            )));
+                ),
+            ));
         }
         previous_step = size;
         for (a, d) in alpha.iter_mut().zip(step.iter()) {
@@ -387,9 +397,12 @@ pub fn evaluate_into(
         this.add_geometric(&points, &stresses, &mut k);
     }
     let lu = k_aa.lu();
-    let correction = lu
-        .solve(&k_au)
-        .ok_or_else(|| Error::NoConvergence("singular enhanced-strain stiffness".into()))?;
+    let correction = lu.solve(&k_au).ok_or_else(|| {
+        Error::no_convergence(
+            crate::error::Failure::Local,
+            "singular enhanced-strain stiffness",
+        )
+    })?;
     let condensed = &k_ua * correction;
     for j in 0..DOFS {
         for i in 0..DOFS {

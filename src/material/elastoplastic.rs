@@ -242,12 +242,15 @@ impl ElastoPlastic {
     }
 
     fn failure(&self, sig_tr: &Voigt, why: &str) -> Error {
-        Error::NoConvergence(format!(
-            "return mapping ({}, {}): {why}; trial stress {:?}",
-            self.yield_function.describe(),
-            self.hardening.describe(),
-            sig_tr.as_slice()
-        ))
+        Error::no_convergence(
+            crate::error::Failure::Local,
+            format!(
+                "return mapping ({}, {}): {why}; trial stress {:?}",
+                self.yield_function.describe(),
+                self.hardening.describe(),
+                sig_tr.as_slice()
+            ),
+        )
     }
 }
 
@@ -300,10 +303,13 @@ impl ElastoPlastic {
     ) -> Result<Tangent> {
         if !kin.strain.iter().all(|v| v.is_finite()) {
             // A diverging Newton iterate, not bad user input: the solver cuts back.
-            return Err(Error::NoConvergence(format!(
-                "non-finite strain {:?} at an integration point",
-                kin.strain.as_slice()
-            )));
+            return Err(Error::no_convergence(
+                crate::error::Failure::Local,
+                format!(
+                    "non-finite strain {:?} at an integration point",
+                    kin.strain.as_slice()
+                ),
+            ));
         }
         let ebar_n = committed.eq_plastic_strain;
         let sig_tr = self
@@ -737,7 +743,7 @@ mod tests {
         let bad = Kinematics::from_strain(Voigt::new(f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0));
         assert!(matches!(
             m.update(&bad, &PointState::default(), &mut st),
-            Err(Error::NoConvergence(_))
+            Err(Error::NoConvergence { .. })
         ));
         assert!(m.describe().contains("Hill48 F=0.5"));
     }

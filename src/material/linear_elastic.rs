@@ -139,10 +139,13 @@ impl Material for LinearElastic {
     ) -> Result<Tangent> {
         if !kin.strain.iter().all(|v| v.is_finite()) {
             // A diverging Newton iterate, not bad user input: the solver cuts back.
-            return Err(Error::NoConvergence(format!(
-                "non-finite strain {:?} at an integration point",
-                kin.strain.as_slice()
-            )));
+            return Err(Error::no_convergence(
+                crate::error::Failure::Local,
+                format!(
+                    "non-finite strain {:?} at an integration point",
+                    kin.strain.as_slice()
+                ),
+            ));
         }
         // Elastic: no history, the stress depends on the current strain only.
         *trial = PointState {

@@ -106,18 +106,24 @@ impl LogStrain {
     /// (Self::from_displacement_gradient) forms it without round-off from `I`.
     pub fn from_stretch_excess(a: &Mat3) -> Result<Self> {
         if !a.iter().all(|v| v.is_finite()) {
-            return Err(Error::NoConvergence(format!(
-                "non-finite right Cauchy-Green tensor {:?}",
-                (a + Mat3::identity()).as_slice()
-            )));
+            return Err(Error::no_convergence(
+                crate::error::Failure::Local,
+                format!(
+                    "non-finite right Cauchy-Green tensor {:?}",
+                    (a + Mat3::identity()).as_slice()
+                ),
+            ));
         }
         let sym = (a + a.transpose()) * 0.5;
         let (mu, q) = sym_eigen3(&sym);
         let lambda = mu.map(|m| 1.0 + m);
         if mu.iter().any(|&m| m.is_nan() || m <= -1.0) {
-            return Err(Error::NoConvergence(format!(
-                "right Cauchy-Green tensor with eigenvalues {lambda:?} (inverted material)"
-            )));
+            return Err(Error::no_convergence(
+                crate::error::Failure::Local,
+                format!(
+                    "right Cauchy-Green tensor with eigenvalues {lambda:?} (inverted material)"
+                ),
+            ));
         }
         let (f1, f2) = divided_differences(&lambda);
         let basis = eigenbasis_units(&q);
@@ -272,9 +278,10 @@ fn log_kinematics(h: &Mat3) -> Result<(Mat3, f64, LogStrain, Kinematics)> {
     let f = Mat3::identity() + h;
     let j = f.determinant();
     if j <= 0.0 || !j.is_finite() {
-        return Err(Error::NoConvergence(format!(
-            "deformation gradient with determinant {j} (inverted material)"
-        )));
+        return Err(Error::no_convergence(
+            crate::error::Failure::Local,
+            format!("deformation gradient with determinant {j} (inverted material)"),
+        ));
     }
     let ls = LogStrain::from_displacement_gradient(h)?;
     let kin = Kinematics {

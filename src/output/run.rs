@@ -21,6 +21,9 @@ pub struct Stop {
     pub final_checkpoint: Option<String>,
     /// Files that could not be written at the stop, each with its error.
     pub write_failures: Vec<String>,
+    /// Why the last increment failed to converge, when it did (its kind, and whether some
+    /// contact status cycled).
+    pub failure: Option<(crate::error::Failure, bool)>,
 }
 
 /// The units of the script's numbers, for the column headers of history.csv (the engine
@@ -406,6 +409,7 @@ impl RunOutput {
             reason: e.to_string(),
             final_checkpoint: None,
             write_failures: Vec::new(),
+            failure: None,
         });
         self.write_summary_of(sim, wall_time_s, stop.as_ref())
     }
@@ -462,6 +466,10 @@ impl RunOutput {
             },
             "error": stop.filter(|s| s.status != "interrupted").map(|s| &s.reason),
             "stop_reason": stop.map(|s| &s.reason),
+            "failure": stop.and_then(|s| s.failure).map(|(kind, cycling)| serde_json::json!({
+                "kind": kind.name(),
+                "status_cycling": cycling,
+            })),
             "final_checkpoint": stop.and_then(|s| s.final_checkpoint.as_ref()),
             "write_failures": stop.map(|s| &s.write_failures),
             "time": sim.time(),

@@ -38,6 +38,9 @@ pub struct SimState {
     checkpoint_due: Option<String>,
     /// Increment count of the state last saved as checkpoints/final.json.
     final_saved: Option<usize>,
+    /// Why the simulation's last increment failed (its kind, and whether a contact status
+    /// cycled), for summary.json at the stop.
+    failure: Option<(crate::error::Failure, bool)>,
     /// The progress bar of a running `sim.run()`: warnings are printed with the bar cleared
     /// and drawn again under them, so the bar's line is not repeated above every warning.
     progress: Option<indicatif::ProgressBar>,
@@ -326,11 +329,17 @@ impl SimState {
             Err(Error::Interrupted(why)) => Err(interrupted(&why)),
             Err(err) => {
                 let mut err = err;
+                self.failure = Some(err.failure());
                 if let Some(saved) = self.record_stop("stopped", &err.to_string()) {
-                    err = Error::NoConvergence(format!(
-                        "{}; {saved}",
-                        err.to_string().trim_start_matches("no convergence: "),
-                    ));
+                    let (kind, cycling) = err.failure();
+                    err = Error::NoConvergence {
+                        kind,
+                        cycling,
+                        message: format!(
+                            "{}; {saved}",
+                            err.to_string().trim_start_matches("no convergence: "),
+                        ),
+                    };
                 }
                 fail(err)
             }
@@ -404,6 +413,7 @@ impl SimState {
             reason: reason.to_string(),
             final_checkpoint: saved.clone(),
             write_failures: failures,
+            failure: self.failure,
         };
         if let Err(e) = out.write_stop_summary(sim, wall, &stop) {
             eprintln!("warning: {e}");
@@ -986,6 +996,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 kept: serde_json::Map::new(),
                 checkpoint_due: None,
                 final_saved: None,
+                failure: None,
                 progress: None,
             }));
             h.simulations.add(sim.clone());

@@ -182,16 +182,14 @@ impl Outcome {
         matches!(self, Outcome::Converged | Outcome::ConvergedCycling)
     }
 
-    /// Classifies a failed run from the solver's message (it names status cycling,
-    /// divergence or the exhausted iteration budget).
+    /// Classifies a failed run by the kind of its last failure ([`Error::failure`]): a
+    /// contact status cycled, the iteration budget ran out, or anything else (growth, a
+    /// non-finite residual, a singular matrix, a failed local solve).
     pub fn of_failure(err: &Error) -> Outcome {
-        let text = err.to_string();
-        if text.contains("status cycling") {
-            Outcome::Cycled
-        } else if text.contains("Newton iterations without convergence") {
-            Outcome::Stalled
-        } else {
-            Outcome::Diverged
+        match err.failure() {
+            (_, true) => Outcome::Cycled,
+            (crate::error::Failure::Stalled, false) => Outcome::Stalled,
+            _ => Outcome::Diverged,
         }
     }
 
@@ -236,4 +234,37 @@ pub(crate) fn seconds(t: Instant) -> f64 {
 /// Writes `text` to `path`, naming the path on failure.
 pub(crate) fn write_file(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|e| Error::io(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Failure;
+
+    /// Studies classify a stop by its typed kind, whatever its message says.
+    #[test]
+    fn outcomes_follow_the_failure_kind_not_the_text() {
+        let stop = |kind, cycling, message: &str| Error::NoConvergence {
+            kind,
+            cycling,
+            message: message.into(),
+        };
+        let misleading = "status cycling; 25 Newton iterations without convergence";
+        assert_eq!(
+            Outcome::of_failure(&stop(Failure::Diverged, false, misleading)),
+            Outcome::Diverged
+        );
+        assert_eq!(
+            Outcome::of_failure(&stop(Failure::Stalled, false, "")),
+            Outcome::Stalled
+        );
+        assert_eq!(
+            Outcome::of_failure(&stop(Failure::ForceGrowth, true, "")),
+            Outcome::Cycled
+        );
+        assert_eq!(
+            Outcome::of_failure(&Error::LinearSolver("singular".into())),
+            Outcome::Diverged
+        );
+    }
 }

@@ -122,10 +122,13 @@ pub fn hertz_measure(sim: &Simulation) -> Result<HertzMeasure> {
         .map(|q| (q.0, q.1))
         .collect();
     if active.len() < 4 {
-        return Err(Error::NoConvergence(format!(
-            "Hertz: only {} node(s) in contact, too few to fit the pressure profile",
-            active.len()
-        )));
+        return Err(Error::no_convergence(
+            crate::error::Failure::Unrecoverable,
+            format!(
+                "Hertz: only {} node(s) in contact, too few to fit the pressure profile",
+                active.len()
+            ),
+        ));
     }
     let fit = &active[..active.len() - 1];
     let (mut sx, mut sy, mut sxx, mut sxy) = (0.0, 0.0, 0.0, 0.0);

@@ -130,10 +130,13 @@ fn measure(v: &CupVariant, scratch: &std::path::Path) -> Result<Measured> {
         })
     };
     if s["status"] != "finished" {
-        return Err(Error::NoConvergence(format!(
-            "square cup stopped: {}",
-            s["error"].as_str().unwrap_or("no reason given")
-        )));
+        return Err(Error::no_convergence(
+            crate::error::Failure::Unrecoverable,
+            format!(
+                "square cup stopped: {}",
+                s["error"].as_str().unwrap_or("no reason given")
+            ),
+        ));
     }
     let draw = &s["draw_in"][0];
     let cost = Cost {

@@ -163,11 +163,14 @@ pub fn run_families<V: Labelled>(
         Some(v) => {
             let p = run_point("reference", v, measure, opts);
             if !p.outcome.converged() {
-                return Err(Error::NoConvergence(format!(
-                    "the reference run '{}' did not finish: {}",
-                    v.label(),
-                    p.failure.unwrap_or_default()
-                )));
+                return Err(Error::no_convergence(
+                    crate::error::Failure::Unrecoverable,
+                    format!(
+                        "the reference run '{}' did not finish: {}",
+                        v.label(),
+                        p.failure.unwrap_or_default()
+                    ),
+                ));
             }
             Some(p)
         }

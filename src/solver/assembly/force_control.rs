@@ -218,7 +218,7 @@ pub fn add_force_rows(
             }
         } else {
             let travel = approach_travel(model, c, nodal).ok_or_else(|| {
-                Error::NoConvergence(format!(
+                Error::no_convergence(crate::error::Failure::Local, format!(
                     "force-controlled tool '{}' touches no node and no node lies ahead of it along its axis [{}, {}, {}]: its position is undetermined",
                     contact.tool.name, fc.axis.x, fc.axis.y, fc.axis.z
                 ))

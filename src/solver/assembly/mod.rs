@@ -149,8 +149,8 @@ fn evaluate_elements(
                 // Any element failure inside an iterate is retryable (a smaller step
                 // may pass), kept as "no convergence" without a second kind prefix.
                 .map_err(|err| match in_element(err, e) {
-                    err @ Error::NoConvergence(_) => err,
-                    other => Error::NoConvergence(other.to_string()),
+                    err @ Error::NoConvergence { .. } => err,
+                    other => Error::no_convergence(crate::error::Failure::Local, other.to_string()),
                 })?;
             approximate += usize::from(solve == LocalSolve::Approximate);
         }

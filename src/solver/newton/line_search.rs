@@ -125,8 +125,9 @@ impl Newton<'_> {
                 err,
                 "every line-search trial failed, the last one",
             )),
-            (None, None) => Err(Error::NoConvergence(
-                "non-finite residual at every line-search step".into(),
+            (None, None) => Err(Error::no_convergence(
+                crate::error::Failure::NonFinite,
+                "non-finite residual at every line-search step",
             )),
         }
     }

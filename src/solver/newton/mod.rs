@@ -17,6 +17,7 @@ pub mod status_prediction;
 
 use crate::contact::ContactNodeState;
 use crate::contact::{ContactStatus, FrameUpdate};
+use crate::error::Failure;
 use crate::geometry::Vec3;
 use crate::interrupt::Interrupt;
 use crate::material::PointState;
@@ -543,14 +544,21 @@ impl Newton<'_> {
             rec.full_step = arrived_whole;
             residuals.push(rec);
             merits.push(merit);
-            let cycling_note = || {
+            // A failure of this attempt: its kind, and the nodes whose status cycled named
+            // at the end of its message.
+            let failure = |kind: Failure, message: String| {
                 let nodes: Vec<usize> = monitor.report(node_of).iter().map(|n| n.node).collect();
-                cycling_note(&nodes)
+                Error::NoConvergence {
+                    kind,
+                    cycling: !nodes.is_empty(),
+                    message: format!("{message}{}", cycling_note(&nodes)),
+                }
             };
             if !(rec.force.is_finite() && rec.contact.is_finite()) {
-                return Err(Error::NoConvergence(format!(
-                    "non-finite residual at iteration {iterations}"
-                )));
+                return Err(Error::no_convergence(
+                    Failure::NonFinite,
+                    format!("non-finite residual at iteration {iterations}"),
+                ));
             }
             let force_ok = rec.force <= force_tolerance(&settings, reference);
             // An element whose local solve stopped early (an inexact iterate, see
@@ -573,12 +581,11 @@ impl Newton<'_> {
                 break;
             }
             if iterations >= settings.max_iterations {
-                return Err(Error::NoConvergence(format!(
-                    "{iterations} Newton iterations without convergence (force residual {:.3e} relative, contact residual {:.3e}); {}{}",
+                return Err(failure(Failure::Stalled, format!(
+                    "{iterations} Newton iterations without convergence (force residual {:.3e} relative, contact residual {:.3e}); {}",
                     rec.force_rel,
                     rec.contact,
                     self.locate(&eval),
-                    cycling_note()
                 )));
             }
             // Growth is measured from the first residual above the tolerance: an increment
@@ -600,12 +607,14 @@ impl Newton<'_> {
                 // Growth of a force residual already below its tolerance is round-off.
                 && !force_ok;
             if grew || (iterations >= 4 && rec.force_rel > 1e6 * first) {
-                return Err(Error::NoConvergence(format!(
-                    "Newton diverges (force residual grew to {:.3e} relative); {}{}",
-                    rec.force_rel,
-                    self.locate(&eval),
-                    cycling_note()
-                )));
+                return Err(failure(
+                    Failure::Diverged,
+                    format!(
+                        "Newton diverges (force residual grew to {:.3e} relative); {}",
+                        rec.force_rel,
+                        self.locate(&eval),
+                    ),
+                ));
             }
             if attempt == Attempt::Regular
                 && forces_on
@@ -613,12 +622,11 @@ impl Newton<'_> {
                 && rec.force > FORCE_GROWTH_LIMIT * first_force
                 && !force_ok
             {
-                return Err(Error::NoConvergence(format!(
-                    "Newton diverges (force residual grew to {:.1} times its first value, {:.3e} relative); {}{}",
+                return Err(failure(Failure::ForceGrowth, format!(
+                    "Newton diverges (force residual grew to {:.1} times its first value, {:.3e} relative); {}",
                     rec.force / first_force,
                     rec.force_rel,
                     self.locate(&eval),
-                    cycling_note()
                 )));
             }
             // An iterate evaluated for its residual only, expected to converge, that did not.
@@ -960,6 +968,28 @@ mod tests {
             }
         }
         assert!(without_jacobian > 0, "no full step was accepted");
+    }
+
+    /// A failure carries its kind, not only a message: an increment whose Newton runs out of
+    /// its budget (one iteration, no cutback, no last resort) fails as `Stalled` at the
+    /// simulation's level, with the message that says so, and commits nothing.
+    #[test]
+    fn an_exhausted_budget_fails_as_stalled() {
+        let mut sim = pressed_and_dragged_strip();
+        let mut settings = sim.model.settings.clone();
+        settings.max_iterations = 1;
+        settings.max_cutbacks = 0;
+        settings.stepping.last_resort = false;
+        sim.change_settings(settings).unwrap();
+        let err = sim.step().unwrap_err();
+        assert_eq!(err.failure(), (Failure::Stalled, false), "{err}");
+        assert!(
+            err.to_string()
+                .contains("Newton iterations without convergence"),
+            "{err}"
+        );
+        assert_eq!(sim.time, 0.0);
+        assert!(sim.history.is_empty());
     }
 
     /// The quadratic model expects convergence in Newton's local phase only.

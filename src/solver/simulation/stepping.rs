@@ -43,7 +43,18 @@ pub(super) const LAST_RESORT_ITERATIONS: usize = 80;
 
 /// Failures after which a smaller increment, or a last resort, may succeed.
 fn retryable(err: &Error) -> bool {
-    matches!(err, Error::NoConvergence(_) | Error::LinearSolver(_))
+    matches!(err, Error::NoConvergence { .. } | Error::LinearSolver(_))
+}
+
+/// The failure of an increment that no cutback or last resort got through: the kind of its
+/// last attempt's failure (and whether a status cycled there), with `message`.
+fn increment_failure(last: &Error, message: String) -> Error {
+    let (kind, cycling) = last.failure();
+    Error::NoConvergence {
+        kind,
+        cycling,
+        message,
+    }
 }
 
 /// One line on a failed attempt: where it was tried and why it failed.
@@ -85,9 +96,10 @@ fn note_last_resort(report: &mut IncrementReport, attempt: Attempt, failures: &[
 /// An error's message without its kind prefix, for nesting in another message.
 pub(super) fn bare(err: &Error) -> String {
     match err {
-        Error::NoConvergence(m) | Error::LinearSolver(m) | Error::Input(m) | Error::Script(m) => {
-            m.clone()
-        }
+        Error::NoConvergence { message: m, .. }
+        | Error::LinearSolver(m)
+        | Error::Input(m)
+        | Error::Script(m) => m.clone(),
         other => other.to_string(),
     }
 }
@@ -221,12 +233,15 @@ impl Simulation {
                             dt = target - self.time;
                         }
                         None => {
-                            return Err(Error::NoConvergence(format!(
-                            "increment {} from t = {} with dt = {dt} after {cutbacks} cutbacks: {}",
-                            self.increments_done + 1,
-                            self.time,
-                            failure_text(&failures, attempt, &err)
-                        )))
+                            return Err(increment_failure(
+                                &err,
+                                format!(
+                                    "increment {} from t = {} with dt = {dt} after {cutbacks} cutbacks: {}",
+                                    self.increments_done + 1,
+                                    self.time,
+                                    failure_text(&failures, attempt, &err)
+                                ),
+                            ))
                         }
                     }
                 }
@@ -307,12 +322,15 @@ impl Simulation {
                         attempt = next;
                     }
                     None => {
-                        return Err(Error::NoConvergence(format!(
-                            "increment {} from t = {} cannot be completed at the minimum step dt = {dt_used:.6e} (dt_min = {dt_min:.6e}) after {cutbacks} cutbacks: {}",
-                            self.increments_done + 1,
-                            self.time,
-                            failure_text(&failures, attempt, &err)
-                        )))
+                        return Err(increment_failure(
+                            &err,
+                            format!(
+                                "increment {} from t = {} cannot be completed at the minimum step dt = {dt_used:.6e} (dt_min = {dt_min:.6e}) after {cutbacks} cutbacks: {}",
+                                self.increments_done + 1,
+                                self.time,
+                                failure_text(&failures, attempt, &err)
+                            ),
+                        ))
                     }
                 },
             }
