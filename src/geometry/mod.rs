@@ -19,7 +19,6 @@ pub mod patch_surface;
 pub mod patch_table;
 pub mod plane;
 pub mod revolution;
-pub mod seams;
 pub mod sphere;
 #[cfg(test)]
 pub(crate) mod testutil;
@@ -29,9 +28,9 @@ pub(crate) use check::{finite_vec3, fmt_vec3, positive_length, unit_vec3};
 
 pub use bezier::{BezierPatch, PatchPoint};
 pub use cylinder::Cylinder;
+pub use patch_surface::seams::SeamReport;
 pub use patch_surface::PatchSurface;
 pub use plane::Plane;
-pub use seams::SeamReport;
 pub use sphere::Sphere;
 
 pub type Vec3 = Vector3<f64>;

@@ -5,7 +5,6 @@
 //! position of every assembled entry in it (`slots`).
 
 use crate::contact::Enforcement;
-use crate::solver::assembly::force_control;
 use crate::solver::assembly::slots::AssemblySlots;
 use crate::solver::model::Model;
 use crate::solver::sparse::SparsePattern;
@@ -42,7 +41,7 @@ impl DofMap {
                 Enforcement::Penalty => None,
             })
             .collect::<Vec<_>>();
-        let tool_offset = force_control::allocate(model, &lambda_offset, &mut next);
+        let tool_offset = allocate_tool_offsets(model, &lambda_offset, &mut next);
         DofMap {
             n_nodes,
             lambda_offset,
@@ -99,10 +98,49 @@ impl DofMap {
                 }
             }
         }
-        force_control::pattern_entries(model, self, &mut entries);
+        tool_offset_entries(model, self, &mut entries);
         for d in 0..self.n_dofs {
             entries.push((d, d));
         }
         SparsePattern::from_entries(self.n_dofs, entries)
+    }
+}
+
+/// Allocates the offset unknowns of force-controlled tools after `next`: one per such tool
+/// that has multipliers (`force_control`).
+fn allocate_tool_offsets(
+    model: &Model,
+    lambda_offset: &[Option<usize>],
+    next: &mut usize,
+) -> Vec<Option<usize>> {
+    model
+        .contacts
+        .iter()
+        .zip(lambda_offset)
+        .map(|(c, l)| match (&c.tool.force_control, l) {
+            (Some(_), Some(_)) => {
+                *next += 1;
+                Some(*next - 1)
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// Sparsity entries of the force-controlled tools' offset unknowns: the column (equilibrium and multiplier rows of
+/// every candidate) and the row (every multiplier); the diagonal is added by the caller.
+fn tool_offset_entries(model: &Model, dofs: &DofMap, entries: &mut Vec<(usize, usize)>) {
+    for (c, contact) in model.contacts.iter().enumerate() {
+        let (Some(s), Some(off)) = (dofs.tool_offset[c], dofs.lambda_offset[c]) else {
+            continue;
+        };
+        for (k, &node) in contact.candidates.iter().enumerate() {
+            let l = off + 3 * k;
+            for i in 0..3 {
+                entries.push((3 * node + i, s));
+                entries.push((l + i, s));
+                entries.push((s, l + i));
+            }
+        }
     }
 }

@@ -38,8 +38,8 @@
 
 use crate::contact::{Enforcement, NodalContact};
 use crate::geometry::{Projection, Vec3};
+use crate::solver::assembly::dofs::DofMap;
 use crate::solver::assembly::slots::ForceControlSlots;
-use crate::solver::assembly::DofMap;
 use crate::solver::model::Model;
 use crate::tool::Pose;
 use crate::{Error, Result};
@@ -57,27 +57,6 @@ pub fn check(model: &Model) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Allocates the offset unknowns after `next`: one per force-controlled tool that has
-/// multipliers.
-pub fn allocate(
-    model: &Model,
-    lambda_offset: &[Option<usize>],
-    next: &mut usize,
-) -> Vec<Option<usize>> {
-    model
-        .contacts
-        .iter()
-        .zip(lambda_offset)
-        .map(|(c, l)| match (&c.tool.force_control, l) {
-            (Some(_), Some(_)) => {
-                *next += 1;
-                Some(*next - 1)
-            }
-            _ => None,
-        })
-        .collect()
 }
 
 /// The offset `s` of tool `c` in the unknowns `x` (0 for a kinematic tool).
@@ -101,24 +80,6 @@ pub fn shifted(scheduled: &Pose, model: &Model, dofs: &DofMap, c: usize, x: &[f6
 /// The pose of tool `c` at time `t` for the unknowns `x`.
 pub fn pose(model: &Model, dofs: &DofMap, c: usize, t: f64, x: &[f64]) -> Pose {
     shifted(&model.contacts[c].tool.pose(t), model, dofs, c, x)
-}
-
-/// Sparsity entries of the offset unknowns: the column (equilibrium and multiplier rows of
-/// every candidate) and the row (every multiplier); the diagonal is added by the caller.
-pub fn pattern_entries(model: &Model, dofs: &DofMap, entries: &mut Vec<(usize, usize)>) {
-    for (c, contact) in model.contacts.iter().enumerate() {
-        let (Some(s), Some(off)) = (dofs.tool_offset[c], dofs.lambda_offset[c]) else {
-            continue;
-        };
-        for (k, &node) in contact.candidates.iter().enumerate() {
-            let l = off + 3 * k;
-            for i in 0..3 {
-                entries.push((3 * node + i, s));
-                entries.push((l + i, s));
-                entries.push((s, l + i));
-            }
-        }
-    }
 }
 
 /// Adds the `s` column of one candidate of force-controlled tool `c` at its precomputed

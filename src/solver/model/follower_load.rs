@@ -12,7 +12,7 @@
 //! N_b,ξ [x_η]×` (`[v]×` the cross-product matrix): `∂f_a/∂x_b = ∫∫ N_a p (N_b,η [x_ξ]× -
 //! N_b,ξ [x_η]×) dξ dη`. Cost: 4 points per face, a 12 x 12 block per face.
 //!
-//! [`Model::add_end_moment`]: `g = (M / I) d`, `X₀` the centroid of the faces and `I =
+//! [`FollowerTraction::end_moment`] (through `Model::add_end_moment`): `g = (M / I) d`, `X₀` the centroid of the faces and `I =
 //! ∫ ((X - X₀)·d)² dA` over them (reference), so that the resultant force is zero and the
 //! resultant moment `∫ p (X - X₀)·d dA = M` about the axis `d × n`, in the reference
 //! configuration; the distribution turns with the face, as a bending moment at the end
@@ -22,8 +22,6 @@ use crate::geometry::{Mat3, Vec3};
 use crate::mesh::Mesh;
 use crate::tool::ScalarSchedule;
 use crate::{Error, Result};
-
-use crate::solver::model::Model;
 
 /// Gauss abscissa of the 2 x 2 face rule (weights 1).
 const G: f64 = 0.577_350_269_189_625_8;
@@ -123,22 +121,23 @@ impl FollowerTraction {
     }
 }
 
-impl Model {
-    /// A follower bending moment `moment · scale(t)` on the boundary faces of the node set
-    /// `set` (an end face of a beam or strip): the traction `p = M y / I` along the current
-    /// face normal, `y = (X - X₀)·d` the reference coordinate along the unit vector
-    /// `direction` (the thickness direction) from the faces' centroid, `I = ∫ y² dA`. See
-    /// the module docs. Errors: a set with no boundary face, a zero `I` (`direction` along
-    /// the face normal), a non-finite moment or direction.
-    pub fn add_end_moment(
-        &mut self,
+impl FollowerTraction {
+    /// A follower bending moment `moment · scale(t)` on the boundary faces of `mesh` within
+    /// `nodes`, the node set `set` (an end face of a beam or strip): the traction
+    /// `p = M y / I` along the current face normal, `y = (X - X₀)·d` the reference
+    /// coordinate along the unit vector `direction` (the thickness direction) from the
+    /// faces' centroid, `I = ∫ y² dA`. See the module docs. Errors: a set with no boundary
+    /// face, a zero `I` (`direction` along the face normal), a non-finite moment or
+    /// direction.
+    pub fn end_moment(
+        mesh: &Mesh,
         set: &str,
+        nodes: &[usize],
         moment: f64,
         direction: Vec3,
         scale: ScalarSchedule,
-    ) -> Result<()> {
-        let nodes = self.nodes(set)?;
-        let faces = self.mesh.faces_within(&nodes)?;
+    ) -> Result<FollowerTraction> {
+        let faces = mesh.faces_within(nodes)?;
         if faces.is_empty() {
             return Err(Error::Input(format!(
                 "end moment on node set '{set}': the set holds no boundary face"
@@ -158,7 +157,7 @@ impl Model {
         let quadrature = |f: &dyn Fn(Vec3) -> f64| -> f64 {
             let mut sum = 0.0;
             for face in &faces {
-                let x = face.map(|n| self.mesh.nodes[n]);
+                let x = face.map(|n| mesh.nodes[n]);
                 for [xi, eta] in FACE_POINTS {
                     let (n, dn) = face_shape(xi, eta);
                     let (mut p, mut a, mut b) = (Vec3::zeros(), Vec3::zeros(), Vec3::zeros());
@@ -188,13 +187,12 @@ impl Model {
                 "must be > 0 (is the direction in the plane of the face?)",
             ));
         }
-        self.follower_loads.push(FollowerTraction {
+        Ok(FollowerTraction {
             label: format!("end moment on {set}"),
             faces,
             origin,
             gradient: d * (moment / inertia),
             scale,
-        });
-        Ok(())
+        })
     }
 }

@@ -11,6 +11,7 @@ use crate::solver::settings::SolverSettings;
 use crate::tool::schedule::ScalarSchedule;
 use crate::tool::Tool;
 use crate::{Error, Result};
+use follower_load::FollowerTraction;
 use std::sync::Arc;
 
 /// Prescribed value of one displacement component on a set of nodes.
@@ -58,7 +59,7 @@ pub struct Model {
     pub dirichlet: Vec<Dirichlet>,
     pub loads: Vec<NodalLoad>,
     /// Loads that turn with the surface (`solver::follower_load`).
-    pub follower_loads: Vec<crate::solver::model::follower_load::FollowerTraction>,
+    pub follower_loads: Vec<FollowerTraction>,
     pub contacts: Vec<ToolContact>,
     pub settings: SolverSettings,
 }
@@ -88,6 +89,22 @@ impl Model {
     /// Node set by name (a face "x-", ..., or one the script defined).
     pub fn nodes(&self, set: &str) -> Result<Vec<usize>> {
         Ok(self.mesh.node_set(set)?.to_vec())
+    }
+
+    /// Adds a follower bending moment `moment · scale(t)` on the boundary faces of the node
+    /// set `set` (an end face of a beam or strip), about `direction` (the thickness
+    /// direction): see [`FollowerTraction::end_moment`].
+    pub fn add_end_moment(
+        &mut self,
+        set: &str,
+        moment: f64,
+        direction: Vec3,
+        scale: ScalarSchedule,
+    ) -> Result<()> {
+        let nodes = self.nodes(set)?;
+        let load = FollowerTraction::end_moment(&self.mesh, set, &nodes, moment, direction, scale)?;
+        self.follower_loads.push(load);
+        Ok(())
     }
 
     /// Prescribes `components` (subset of "xyz") of the nodes of `set` to follow `value`.

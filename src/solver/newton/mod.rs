@@ -203,6 +203,125 @@ impl Attempt {
     }
 }
 
+/// What the divergence guards read of an attempt so far.
+struct Progress<'r> {
+    /// Every iterate's record, the current one last.
+    residuals: &'r [IterationRecord],
+    /// Every iterate's merit, the current one last.
+    merits: &'r [f64],
+    /// Where the merits that count for divergence start (after a freeze, a release or a
+    /// step accepted by the contraction test).
+    window_start: usize,
+    /// Newton steps taken.
+    iterations: usize,
+}
+
+/// The divergence guards of an attempt: a run of merit increases (models without force
+/// control), a force residual grown a millionfold (any), and a force residual grown
+/// `FORCE_GROWTH_LIMIT` times its first value (force-controlled models whose tools all
+/// pressed at the committed state). The last resorts run without the first and the last.
+struct DivergenceGuard {
+    attempt: Attempt,
+    /// While a force-controlled tool's force comes on, the body's residual rises from zero
+    /// for several iterations by design: there, only a residual grown a millionfold counts
+    /// as divergence, not a run of increases.
+    force_controlled: bool,
+    /// Once every such tool pressed at the committed state its force is on, and a force
+    /// residual grown `FORCE_GROWTH_LIMIT` times its first value after two Newton steps is
+    /// an attempt gone astray. Measured (BENCHMARKS.md): on the U-channel (tests/scenes,
+    /// punch at zero gap) the attempts that converged stayed within 1.35 times their first
+    /// force residual from the second iterate on, while 44 of the 76 that failed passed 3
+    /// times and then spent 377 iterations before their end, at force residuals of
+    /// 1e4-1e5 N where the solution's internal forces are 200 N; on the solid-shell
+    /// benchmark cup the converged attempts stayed within 0.93 times. The first step may
+    /// raise it more (a bent sheet's membrane forces: up to 5.1 times on that cup, in
+    /// attempts that converged). A run of merit increases, the guard without force
+    /// control, ended few of the U-channel's failing attempts.
+    forces_on: bool,
+}
+
+impl DivergenceGuard {
+    fn new(newton: &Newton<'_>, attempt: Attempt) -> Self {
+        let offsets = &newton.dofs.tool_offset;
+        let force_controlled = offsets.iter().any(Option::is_some);
+        let forces_on = force_controlled
+            && (0..newton.model.contacts.len())
+                .filter(|&c| offsets[c].is_some())
+                .all(|c| {
+                    newton.contact[c]
+                        .iter()
+                        .any(|s| s.status != ContactStatus::Gap)
+                });
+        DivergenceGuard {
+            attempt,
+            force_controlled,
+            forces_on,
+        }
+    }
+
+    /// The kind and the description of the divergence of the last iterate of `progress`,
+    /// if it diverges (`force_ok`: its force residual is within its tolerance, where growth
+    /// is round-off).
+    fn check(
+        &self,
+        progress: &Progress<'_>,
+        settings: &SolverSettings,
+        force_ok: bool,
+    ) -> Option<(Failure, String)> {
+        let Progress {
+            residuals,
+            merits,
+            window_start,
+            iterations,
+        } = *progress;
+        let rec = residuals.last()?;
+        let merit = *merits.last()?;
+        // Growth is measured from the first residual above the tolerance: an increment
+        // driven only by a force-controlled tool starts from a zero (or round-off) force
+        // residual, which is no scale for growth.
+        let first_record = residuals
+            .iter()
+            .find(|r| r.force_rel > settings.force_rel_tol);
+        let first = first_record.map_or(f64::INFINITY, |r| r.force_rel);
+        let first_force = first_record.map_or(f64::INFINITY, |r| r.force);
+        let first_merit = merits.iter().copied().find(|&v| v > 0.0).unwrap_or(0.0);
+        let grew = self.attempt == Attempt::Regular
+            && !self.force_controlled
+            && merits.len() > window_start + DIVERGENCE_ITERATIONS
+            && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
+                .windows(2)
+                .all(|w| w[1] > w[0])
+            && merit > first_merit
+            // Growth of a force residual already below its tolerance is round-off.
+            && !force_ok;
+        if grew || (iterations >= 4 && rec.force_rel > 1e6 * first) {
+            return Some((
+                Failure::Diverged,
+                format!(
+                    "Newton diverges (force residual grew to {:.3e} relative)",
+                    rec.force_rel
+                ),
+            ));
+        }
+        if self.attempt == Attempt::Regular
+            && self.forces_on
+            && iterations >= 2
+            && rec.force > FORCE_GROWTH_LIMIT * first_force
+            && !force_ok
+        {
+            return Some((
+                Failure::ForceGrowth,
+                format!(
+                    "Newton diverges (force residual grew to {:.1} times its first value, {:.3e} relative)",
+                    rec.force / first_force,
+                    rec.force_rel
+                ),
+            ));
+        }
+        None
+    }
+}
+
 /// A converged Newton solve of one increment, not yet committed.
 pub(super) struct Trial {
     pub(super) x: Vec<f64>,
@@ -412,6 +531,11 @@ impl Newton<'_> {
     /// `max_iterations` iterations. A last-resort `attempt` runs without the divergence
     /// guard; [`Attempt::Continuation`] solves each step from a shifted Jacobian
     /// ([`PseudoTransient`]).
+    ///
+    /// Each iteration: anti-cycling's freeze or release, the residual record, the
+    /// convergence test, the budget and the divergence guards ([`DivergenceGuard`]), the
+    /// Newton correction ([`Self::correction`]) and the line search with the contraction
+    /// test ([`Self::search`]).
     pub(in crate::solver) fn solve(
         &self,
         t_new: f64,
@@ -426,50 +550,14 @@ impl Newton<'_> {
         settings.status_prediction = prediction;
         settings.max_iterations = max_iterations;
         let step = &settings.stepping;
-        let mut x = self.x.to_vec();
         let frozen = match settings.contact.frame {
             FrameUpdate::EveryIteration => None,
             FrameUpdate::Frozen => Some(self.frozen_frames(t_new)),
         };
         let mut ctx = self.context(t_new, frozen);
         let n_u = 3 * self.dofs.n_nodes;
-        let mut weights = vec![0.0; self.dofs.n_dofs - n_u];
-        for (c, contact) in self.model.contacts.iter().enumerate() {
-            if let Some(off) = self.dofs.lambda_offset[c] {
-                for (k, r) in contact.r.iter().enumerate() {
-                    weights[off - n_u + 3 * k..off - n_u + 3 * k + 3].fill(*r);
-                }
-            }
-            // A force-controlled tool's force row (a length: force error / r_s) enters the
-            // merit times r_s, as a force error; its approach row does not (see
-            // `residual_record`).
-            if let Some(s) = self.dofs.tool_offset[c] {
-                weights[s - n_u] = force_control::row_scale(&self.model, c);
-            }
-        }
-        // While a force-controlled tool's force comes on, the body's residual rises from
-        // zero for several iterations by design: there, only a residual grown a millionfold
-        // counts as divergence, not a run of increases.
-        let force_controlled = self.dofs.tool_offset.iter().any(Option::is_some);
-        // Once every such tool pressed at the committed state its force is on, and a force
-        // residual grown `FORCE_GROWTH_LIMIT` times its first value after two Newton steps
-        // is an attempt gone astray. Measured (BENCHMARKS.md): on the U-channel (tests/scenes,
-        // punch at zero gap) the attempts that converged stayed within 1.35 times their first
-        // force residual from the second iterate on, while 44 of the 76 that failed passed 3
-        // times and then spent 377 iterations before their end, at force residuals of
-        // 1e4-1e5 N where the solution's internal forces are 200 N; on the solid-shell
-        // benchmark cup the converged attempts stayed within 0.93 times. The first step may
-        // raise it more (a bent sheet's membrane forces: up to 5.1 times on that cup, in
-        // attempts that converged). A run of merit increases, the guard without force
-        // control, ended few of the U-channel's failing attempts.
-        let forces_on = force_controlled
-            && (0..self.model.contacts.len())
-                .filter(|&c| self.dofs.tool_offset[c].is_some())
-                .all(|c| {
-                    self.contact[c]
-                        .iter()
-                        .any(|s| s.status != ContactStatus::Gap)
-                });
+        let weights = self.merit_weights();
+        let guard = DivergenceGuard::new(self, attempt);
         let sizes: Vec<usize> = self
             .model
             .contacts
@@ -478,46 +566,8 @@ impl Newton<'_> {
             .collect();
         let mut monitor = CyclingMonitor::new(&sizes, step.anti_cycling, step.cycle_flips);
         let node_of = |c: usize, k: usize| self.model.contacts[c].candidates[k];
-        let unextrapolated = (settings.extrapolate && self.last_step.is_some()).then(|| x.clone());
-        if settings.extrapolate {
-            self.extrapolate(t_new, &mut x);
-        }
-        // Named in the error: a first iterate that cannot be evaluated (an element inverted
-        // by the extrapolated guess, say) fails the attempt before Newton starts.
-        let first = if unextrapolated.is_some() {
-            "at the first iterate (extrapolated from the last increment)"
-        } else {
-            "at the first iterate"
-        };
-        let mut eval = self
-            .start_iterate(&ctx, t_new, &mut x, linear, times)
-            .and_then(|()| ctx.evaluate(&x, times))
-            .map_err(|err| crate::element::prefix(err, first))?;
-        // The extrapolated start is a guess that the increment continues the last one's
-        // motion. Where it does not (a rotating thin beam: continued linearly, a rotation
-        // stretches the fibres, whose membrane stiffness is (L/t)^2 times the bending one),
-        // it can start Newton far outside its basin: on a cantilever turning 0.25 rad per
-        // increment the extrapolated start had 200 times the merit of the committed one and
-        // the increment failed. So a start whose merit exceeds the unextrapolated start's
-        // tenfold is dropped (one residual-only evaluation per increment; in forming the
-        // extrapolated start is the better one by far: a tool moved without the sheet
-        // penetrates it).
-        if let Some(mut plain) = unextrapolated {
-            self.start_iterate(&ctx, t_new, &mut plain, linear, times)?;
-            let merit_of = |e: &Evaluation| self.residual_record(e, &weights).1;
-            let extrapolated = merit_of(&eval);
-            let committed = self
-                .committed_residual(&ctx, &plain, times)
-                .map(|e| merit_of(&e))
-                .unwrap_or(f64::INFINITY);
-            if !(extrapolated <= EXTRAPOLATION_GUARD * committed) && committed.is_finite() {
-                x = plain;
-                eval = ctx.evaluate(&x, times)?;
-            }
-        }
-        if self.seat_force_controlled_tools(&eval, &mut x) {
-            eval = ctx.evaluate(&x, times)?;
-        }
+        let (mut x, mut eval) =
+            self.first_iterate(&ctx, t_new, settings.extrapolate, &weights, linear, times)?;
         let mut residuals = Vec::new();
         let mut statuses: Vec<Vec<ContactStatus>> = Vec::new();
         let mut yielding: Vec<bool> = Vec::new();
@@ -540,7 +590,7 @@ impl Newton<'_> {
             }
             let (mut rec, merit, reference) = self.residual_record(&eval, &weights);
             rec.status_changes = status_changes(&mut statuses, &eval);
-            rec.yield_changes = yield_changes(&mut yielding, &self.points, &eval);
+            rec.yield_changes = yield_changes(&mut yielding, self.points, &eval);
             rec.full_step = arrived_whole;
             residuals.push(rec);
             merits.push(merit);
@@ -588,102 +638,38 @@ impl Newton<'_> {
                     self.locate(&eval),
                 )));
             }
-            // Growth is measured from the first residual above the tolerance: an increment
-            // driven only by a force-controlled tool starts from a zero (or round-off) force
-            // residual, which is no scale for growth.
-            let first_record = residuals
-                .iter()
-                .find(|r| r.force_rel > settings.force_rel_tol);
-            let first = first_record.map_or(f64::INFINITY, |r| r.force_rel);
-            let first_force = first_record.map_or(f64::INFINITY, |r| r.force);
-            let first_merit = merits.iter().copied().find(|&v| v > 0.0).unwrap_or(0.0);
-            let grew = attempt == Attempt::Regular
-                && !force_controlled
-                && merits.len() > window_start + DIVERGENCE_ITERATIONS
-                && merits[merits.len() - 1 - DIVERGENCE_ITERATIONS..]
-                    .windows(2)
-                    .all(|w| w[1] > w[0])
-                && merit > first_merit
-                // Growth of a force residual already below its tolerance is round-off.
-                && !force_ok;
-            if grew || (iterations >= 4 && rec.force_rel > 1e6 * first) {
-                return Err(failure(
-                    Failure::Diverged,
-                    format!(
-                        "Newton diverges (force residual grew to {:.3e} relative); {}",
-                        rec.force_rel,
-                        self.locate(&eval),
-                    ),
-                ));
-            }
-            if attempt == Attempt::Regular
-                && forces_on
-                && iterations >= 2
-                && rec.force > FORCE_GROWTH_LIMIT * first_force
-                && !force_ok
-            {
-                return Err(failure(Failure::ForceGrowth, format!(
-                    "Newton diverges (force residual grew to {:.1} times its first value, {:.3e} relative); {}",
-                    rec.force / first_force,
-                    rec.force_rel,
-                    self.locate(&eval),
-                )));
+            let history = Progress {
+                residuals: &residuals,
+                merits: &merits,
+                window_start,
+                iterations,
+            };
+            if let Some((kind, what)) = guard.check(&history, &settings, force_ok) {
+                return Err(failure(kind, format!("{what}; {}", self.locate(&eval))));
             }
             // An iterate evaluated for its residual only, expected to converge, that did not.
             if !eval.has_jacobian() {
                 eval = ctx.complete(&x, eval, times)?;
             }
-            times.newton_steps += 1;
-            let ts = Instant::now();
-            let dx = match (next_step.take(), continuation.as_mut()) {
-                (Some(dx), _) => dx,
-                (None, Some(ptc)) => {
-                    let sigma = ptc.shift(merit);
-                    PseudoTransient::step(self, &mut eval, n_u, sigma, linear)?
-                }
-                (None, None) => self.newton_step(&eval, linear)?,
-            };
-            // Frozen statuses (anti-cycling) are a problem of their own: not re-linearised.
-            let dx = if settings.status_prediction > 0 && ctx.forced.is_none() {
-                self.status_consistent_step(
-                    &mut ctx,
-                    &x,
-                    &eval,
-                    dx,
-                    linear,
-                    times,
-                    settings.status_prediction,
-                )?
-            } else {
-                dx
-            };
-            times.factorization_and_solve += ts.elapsed().as_secs_f64();
+            let dx = self.correction(
+                &mut ctx,
+                &x,
+                &mut eval,
+                next_step.take(),
+                continuation.as_mut(),
+                merit,
+                settings.status_prediction,
+                linear,
+                times,
+            )?;
             if let Some(last) = residuals.last_mut() {
                 last.correction = norm(&dx[..n_u]);
             }
-            // A step that brings a force-controlled tool to first touch is taken whole: the
-            // merit cannot judge it (its force row only starts to count once touching).
-            let approach = (0..self.model.contacts.len())
-                .any(|c| force_control::approaching(&self.model, c, &eval.nodal));
-            let mut contracted = None;
-            let mut contraction_time = 0.0;
-            let (x_new, eval_new, cuts) = self.line_search(
-                &ctx,
-                &x,
-                &dx,
-                if approach { f64::INFINITY } else { merit },
-                monitor.damping(),
-                &weights,
-                &mut |trial| {
-                    let ts = Instant::now();
-                    contracted = self.newton_contraction(&eval, trial, &dx, linear)?;
-                    contraction_time += ts.elapsed().as_secs_f64();
-                    Ok(contracted.is_some())
-                },
-                converges_next(&residuals, &settings, reference),
-                times,
+            let converges = converges_next(&residuals, &settings, reference);
+            let damping = monitor.damping();
+            let (x_new, eval_new, cuts, contracted) = self.search(
+                &ctx, &x, &dx, &eval, merit, damping, &weights, converges, linear, times,
             )?;
-            times.factorization_and_solve += contraction_time;
             // A full step accepted by the contraction test may raise |R|: the merits
             // before it are no scale for divergence.
             if contracted.is_some() {
@@ -691,7 +677,7 @@ impl Newton<'_> {
             }
             next_step = contracted;
             line_search_cuts += cuts;
-            arrived_whole = cuts == 0 && monitor.damping() == 1.0;
+            arrived_whole = cuts == 0 && damping == 1.0;
             x = x_new;
             eval = eval_new;
             iterations += 1;
@@ -706,6 +692,167 @@ impl Newton<'_> {
             line_search_cuts,
             element_memory: ctx.element_memory.into_inner(),
         })
+    }
+
+    /// The weights of the multiplier rows in the merit function: each contact row (a
+    /// length) times its node's r, a force; a force-controlled tool's force row (a length:
+    /// force error / r_s) times r_s, as a force error (its approach row does not count,
+    /// see `residual_record`).
+    fn merit_weights(&self) -> Vec<f64> {
+        let n_u = 3 * self.dofs.n_nodes;
+        let mut weights = vec![0.0; self.dofs.n_dofs - n_u];
+        for (c, contact) in self.model.contacts.iter().enumerate() {
+            if let Some(off) = self.dofs.lambda_offset[c] {
+                for (k, r) in contact.r.iter().enumerate() {
+                    weights[off - n_u + 3 * k..off - n_u + 3 * k + 3].fill(*r);
+                }
+            }
+            if let Some(s) = self.dofs.tool_offset[c] {
+                weights[s - n_u] = force_control::row_scale(self.model, c);
+            }
+        }
+        weights
+    }
+
+    /// The first iterate of an increment to `t_new` and its evaluation: the committed
+    /// unknowns, extrapolated from the last increment when `extrapolate` says so (unless
+    /// that start's merit is tenfold the unextrapolated one's), with the Dirichlet
+    /// predictor and the increment's prescribed values, force-controlled tools touching
+    /// nothing seated on their nearest node.
+    fn first_iterate(
+        &self,
+        ctx: &IncrementContext<'_>,
+        t_new: f64,
+        extrapolate: bool,
+        weights: &[f64],
+        linear: &mut dyn LinearSolver,
+        times: &mut PhaseTimes,
+    ) -> Result<(Vec<f64>, Evaluation)> {
+        let mut x = self.x.to_vec();
+        let unextrapolated = (extrapolate && self.last_step.is_some()).then(|| x.clone());
+        if extrapolate {
+            self.extrapolate(t_new, &mut x);
+        }
+        // Named in the error: a first iterate that cannot be evaluated (an element inverted
+        // by the extrapolated guess, say) fails the attempt before Newton starts.
+        let first = if unextrapolated.is_some() {
+            "at the first iterate (extrapolated from the last increment)"
+        } else {
+            "at the first iterate"
+        };
+        let mut eval = self
+            .start_iterate(ctx, t_new, &mut x, linear, times)
+            .and_then(|()| ctx.evaluate(&x, times))
+            .map_err(|err| crate::element::prefix(err, first))?;
+        // The extrapolated start is a guess that the increment continues the last one's
+        // motion. Where it does not (a rotating thin beam: continued linearly, a rotation
+        // stretches the fibres, whose membrane stiffness is (L/t)^2 times the bending one),
+        // it can start Newton far outside its basin: on a cantilever turning 0.25 rad per
+        // increment the extrapolated start had 200 times the merit of the committed one and
+        // the increment failed. So a start whose merit exceeds the unextrapolated start's
+        // tenfold is dropped (one residual-only evaluation per increment; in forming the
+        // extrapolated start is the better one by far: a tool moved without the sheet
+        // penetrates it).
+        if let Some(mut plain) = unextrapolated {
+            self.start_iterate(ctx, t_new, &mut plain, linear, times)?;
+            let merit_of = |e: &Evaluation| self.residual_record(e, weights).1;
+            let extrapolated = merit_of(&eval);
+            let committed = self
+                .committed_residual(ctx, &plain, times)
+                .map(|e| merit_of(&e))
+                .unwrap_or(f64::INFINITY);
+            if !(extrapolated <= EXTRAPOLATION_GUARD * committed) && committed.is_finite() {
+                x = plain;
+                eval = ctx.evaluate(&x, times)?;
+            }
+        }
+        if self.seat_force_controlled_tools(&eval, &mut x) {
+            eval = ctx.evaluate(&x, times)?;
+        }
+        Ok((x, eval))
+    }
+
+    /// The Newton correction at `x` (evaluated as `eval`, with its Jacobian): the one the
+    /// contraction test already solved (`solved`), or one solved now, from the Jacobian
+    /// shifted by pseudo-transient continuation when it runs; then re-solved with status
+    /// prediction (`prediction` rounds), unless anti-cycling froze statuses, which are a
+    /// problem of their own.
+    #[allow(clippy::too_many_arguments)]
+    fn correction(
+        &self,
+        ctx: &mut IncrementContext<'_>,
+        x: &[f64],
+        eval: &mut Evaluation,
+        solved: Option<Vec<f64>>,
+        continuation: Option<&mut PseudoTransient>,
+        merit: f64,
+        prediction: usize,
+        linear: &mut dyn LinearSolver,
+        times: &mut PhaseTimes,
+    ) -> Result<Vec<f64>> {
+        let n_u = 3 * self.dofs.n_nodes;
+        times.newton_steps += 1;
+        let ts = Instant::now();
+        let dx = match (solved, continuation) {
+            (Some(dx), _) => dx,
+            (None, Some(ptc)) => {
+                let sigma = ptc.shift(merit);
+                PseudoTransient::step(self, eval, n_u, sigma, linear)?
+            }
+            (None, None) => self.newton_step(eval, linear)?,
+        };
+        let dx = if prediction > 0 && ctx.forced.is_none() {
+            self.status_consistent_step(ctx, x, eval, dx, linear, times, prediction)?
+        } else {
+            dx
+        };
+        times.factorization_and_solve += ts.elapsed().as_secs_f64();
+        Ok(dx)
+    }
+
+    /// The line search along `dx` from `x` (evaluated as `eval`, merit `merit`), scaled by
+    /// anti-cycling's `damping`, with the contraction test for a full step that raises the
+    /// merit ([`Self::newton_contraction`]); a step that brings a force-controlled tool to
+    /// first touch is taken whole (the merit cannot judge it: its force row only starts to
+    /// count once touching). `converges`: the next iterate is expected to converge
+    /// ([`converges_next`]). Returns the new iterate, its evaluation, the line search's cuts
+    /// and the next Newton correction when the contraction test solved it.
+    #[allow(clippy::too_many_arguments)]
+    fn search(
+        &self,
+        ctx: &IncrementContext<'_>,
+        x: &[f64],
+        dx: &[f64],
+        eval: &Evaluation,
+        merit: f64,
+        damping: f64,
+        weights: &[f64],
+        converges: bool,
+        linear: &mut dyn LinearSolver,
+        times: &mut PhaseTimes,
+    ) -> Result<(Vec<f64>, Evaluation, usize, Option<Vec<f64>>)> {
+        let approach = (0..self.model.contacts.len())
+            .any(|c| force_control::approaching(self.model, c, &eval.nodal));
+        let mut contracted = None;
+        let mut contraction_time = 0.0;
+        let (x_new, eval_new, cuts) = self.line_search(
+            ctx,
+            x,
+            dx,
+            if approach { f64::INFINITY } else { merit },
+            damping,
+            weights,
+            &mut |trial| {
+                let ts = Instant::now();
+                contracted = self.newton_contraction(eval, trial, dx, linear)?;
+                contraction_time += ts.elapsed().as_secs_f64();
+                Ok(contracted.is_some())
+            },
+            converges,
+            times,
+        )?;
+        times.factorization_and_solve += contraction_time;
+        Ok((x_new, eval_new, cuts, contracted))
     }
 
     pub(super) fn frozen_frames(&self, t_new: f64) -> Vec<Vec<Option<FrozenFrame>>> {

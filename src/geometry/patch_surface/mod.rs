@@ -28,14 +28,16 @@
 //! On an edge or corner the sign of `n` (and of `d`) is that of the patch normal's side, so
 //! `n` is continuous where the foot passes from the inside of the patch to its edge.
 
+pub mod seams;
+
 use super::bezier::{BezierPatch, PatchPoint};
 use super::bvh::{box_distance, Bvh};
 use super::kdop::Kdop;
-use super::seams::{seam_report, SeamReport};
 use super::trim::PieceTrim;
 use super::*;
 use crate::{Error, Result};
 use nalgebra::{Matrix2, Matrix3x2};
+use seams::{seam_report, SeamReport};
 
 /// Coarse samples per direction for a cold start (the grid has `(N + 1)^2` points).
 const COLD_SAMPLES: usize = 8;

@@ -12,8 +12,8 @@
 //! ways: one of them is inward-facing. The surface is refused, naming the patch that
 //! disagrees with most of its neighbours (the majority orientation decides).
 
-use super::patch_surface::PatchSurface;
-use super::*;
+use super::PatchSurface;
+use crate::geometry::*;
 use crate::{Error, Result};
 
 const EDGE_SAMPLES: usize = 16;
