@@ -29,7 +29,7 @@ use crate::solver::linear::LinearSolver;
 use crate::solver::model::Model;
 use crate::solver::newton::cycling::{CyclingMonitor, CyclingNode};
 use crate::solver::newton::pseudo_transient::PseudoTransient;
-use crate::solver::settings::SolverSettings;
+use crate::solver::settings::{SolverSettings, StepSettings};
 use crate::solver::sparse::SparsePattern;
 use crate::{Error, Result};
 use std::sync::Arc;
@@ -558,13 +558,7 @@ impl Newton<'_> {
         let n_u = 3 * self.dofs.n_nodes;
         let weights = self.merit_weights();
         let guard = DivergenceGuard::new(self, attempt);
-        let sizes: Vec<usize> = self
-            .model
-            .contacts
-            .iter()
-            .map(|c| c.candidates.len())
-            .collect();
-        let mut monitor = CyclingMonitor::new(&sizes, step.anti_cycling, step.cycle_flips);
+        let mut monitor = self.cycling_monitor(step);
         let node_of = |c: usize, k: usize| self.model.contacts[c].candidates[k];
         let (mut x, mut eval) =
             self.first_iterate(&ctx, t_new, settings.extrapolate, &weights, linear, times)?;
@@ -631,12 +625,14 @@ impl Newton<'_> {
                 break;
             }
             if iterations >= settings.max_iterations {
-                return Err(failure(Failure::Stalled, format!(
-                    "{iterations} Newton iterations without convergence (force residual {:.3e} relative, contact residual {:.3e}); {}",
-                    rec.force_rel,
-                    rec.contact,
-                    self.locate(&eval),
-                )));
+                let what = format!(
+                    "{iterations} Newton iterations without convergence (force residual {:.3e} relative, contact residual {:.3e})",
+                    rec.force_rel, rec.contact
+                );
+                return Err(failure(
+                    Failure::Stalled,
+                    format!("{what}; {}", self.locate(&eval)),
+                ));
             }
             let history = Progress {
                 residuals: &residuals,
@@ -692,6 +688,17 @@ impl Newton<'_> {
             line_search_cuts,
             element_memory: ctx.element_memory.into_inner(),
         })
+    }
+
+    /// Anti-cycling's watch over every (tool, candidate) pair's status.
+    fn cycling_monitor(&self, step: &StepSettings) -> CyclingMonitor {
+        let sizes: Vec<usize> = self
+            .model
+            .contacts
+            .iter()
+            .map(|c| c.candidates.len())
+            .collect();
+        CyclingMonitor::new(&sizes, step.anti_cycling, step.cycle_flips)
     }
 
     /// The weights of the multiplier rows in the merit function: each contact row (a
