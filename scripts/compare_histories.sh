@@ -18,7 +18,8 @@ mkdir -p "$work"
 cases=(
   "paper|scripts/square_cup.rhai|--set charts=false"
   "benchmark|scripts/square_cup.rhai|--set charts=false --set variant=\"benchmark\""
-  "u_channel|tests/scenes/u_channel.rhai|"
+  "u_channel_touching|tests/scenes/u_channel.rhai|--set only=0.0"
+  "u_channel_lifted|tests/scenes/u_channel.rhai|--set only=0.1"
   "cylindrical_cup|scripts/cylindrical_cup.rhai|"
 )
 status=0

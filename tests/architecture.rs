@@ -160,7 +160,15 @@ const RULES: &[Rule] = &[
 
 /// The layers under the solver and the foundation.
 const UNDER_SOLVER: &[&str] = &[
-    "geometry", "cad", "contact", "tool", "mesh", "material", "element", "error", "paths",
+    "geometry",
+    "cad",
+    "contact",
+    "tool",
+    "mesh",
+    "material",
+    "element",
+    "error",
+    "paths",
     "interrupt",
 ];
 

@@ -1,6 +1,6 @@
 //! Finite rotation with one solid-shell layer (issue 15): a cantilever rolled into a full
 //! circle by a follower end moment, and the follower load's own stiffness against central
-//! differences. See `src/solver/follower_load.rs`.
+//! differences. See `src/solver/model/follower_load.rs`.
 
 use std::sync::Arc;
 

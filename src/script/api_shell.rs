@@ -1,6 +1,6 @@
 //! Script functions for shell models: `sim.end_moment(set, direction, moment)` and
 //! `sim.end_moment(set, direction, moment, scale)`, a follower bending moment on an end
-//! face ([`crate::solver::Model::add_end_moment`], `src/solver/follower_load.rs`).
+//! face ([`crate::solver::Model::add_end_moment`], `src/solver/model/follower_load.rs`).
 //!
 //! The traction on the faces of `set` is `p = M y / I` along their current normal, with
 //! `y` the reference coordinate along `direction` (the thickness direction) from the faces'

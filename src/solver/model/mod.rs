@@ -58,7 +58,7 @@ pub struct Model {
     pub material: Arc<dyn Material>,
     pub dirichlet: Vec<Dirichlet>,
     pub loads: Vec<NodalLoad>,
-    /// Loads that turn with the surface (`solver::follower_load`).
+    /// Loads that turn with the surface (`follower_load`).
     pub follower_loads: Vec<FollowerTraction>,
     pub contacts: Vec<ToolContact>,
     pub settings: SolverSettings,

@@ -8,7 +8,7 @@ use crate::{Error, Result};
 const LINE_SEARCH_CUTS: usize = 4;
 /// Further halvings, residual-only, when every trial down to 1/16 raised the merit at
 /// least `KINK_MERIT_RISE` times (smallest step 2^-16 of the Newton step); see
-/// [`Simulation::line_search`].
+/// [`Newton::line_search`].
 const DEEP_CUTS: usize = 12;
 /// How many times the merit of the best trial down to 1/16 must exceed the start's for the
 /// deeper cuts: along a Newton step the merit's slope at the start is `-|R|`, so a tenfold

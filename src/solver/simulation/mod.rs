@@ -92,7 +92,7 @@ pub struct Simulation {
     pub(super) committed_memory: Vec<f64>,
     /// The elements' internal forces at the committed state (the converged evaluation's),
     /// so that the extrapolation guard's evaluation at the committed unknowns needs no
-    /// element pass (`Simulation::committed_residual`); `None` before the first increment
+    /// element pass (`Newton::committed_residual`); `None` before the first increment
     /// and after a restore.
     pub(super) committed_forces: Option<Vec<f64>>,
     pub(super) condenser: Option<Condenser>,
