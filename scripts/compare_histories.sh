@@ -2,9 +2,8 @@
 # Runs the four main jobs with two tribo binaries and compares their histories byte for byte:
 # the paper and benchmark square cups, both U-channel variants (punch touching the strip and
 # 0.1 mm above it, one run each: the scene writes both into one folder) and the cylindrical
-# cup. A
-# change that reshapes code without changing what it computes must leave every history.csv
-# identical (history.csv holds no wall time).
+# cup. A change that reshapes code without changing what it computes must leave every
+# history.csv identical (history.csv holds no wall time).
 #
 #   scripts/compare_histories.sh BEFORE_BIN AFTER_BIN [WORK_DIR]
 #
