@@ -2,13 +2,13 @@
 
 use super::api_scene::{scalar_schedule, ScriptMaterial};
 use super::convert::*;
+use super::settings::{apply_settings, FrameKnobs, Knobs};
 use super::HostOptions;
-use crate::contact::{Enforcement, FrameUpdate};
 use crate::contact::{FrictionInput, FrictionLaw};
 use crate::mesh::Mesh;
-use crate::output::{Cadence, Configuration, OutputOptions, RunOutput, Units};
+use crate::output::RunOutput;
 use crate::solver::simulation::checkpoint::Checkpoint;
-use crate::solver::{AntiCycling, IncrementReport, Model, Simulation, SolverSettings, StepMode};
+use crate::solver::{IncrementReport, Model, Simulation};
 use crate::tool::Tool;
 use crate::Error;
 use rhai::{Array, Dynamic, Engine, FnPtr, Map, NativeCallContext};
@@ -625,384 +625,97 @@ pub(super) fn interrupted(why: &str) -> Box<rhai::EvalAltResult> {
     ))
 }
 
-/// The output settings of a script: `output_every` (0: no output), `output_interval`,
-/// `frame_points`, `units`, `model_fraction`. The cadence is resolved when the simulation
-/// starts (the default interval depends on the end time).
-#[derive(Clone, Debug)]
-struct FrameKnobs {
-    off: bool,
-    cadence: Option<Cadence>,
-    points: Configuration,
-    units: Units,
-    model_fraction: f64,
-}
-
-impl Default for FrameKnobs {
-    fn default() -> Self {
-        FrameKnobs {
-            off: false,
-            cadence: None,
-            points: Configuration::Current,
-            units: Units::default(),
-            model_fraction: 1.0,
-        }
-    }
-}
-
-impl FrameKnobs {
-    fn options(&self, end_time: f64) -> OutputOptions {
-        OutputOptions {
-            points: self.points,
-            cadence: self
-                .cadence
-                .unwrap_or_else(|| Cadence::default_for(end_time)),
-            units: self.units.clone(),
-            model_fraction: self.model_fraction,
-        }
-    }
-}
-
-/// `units: #{ length: "mm", force: "N", time: "mm" }` (each key optional).
-fn units(v: &Dynamic, into: &mut Units) -> ScriptResult<()> {
-    let Some(map) = v.clone().try_cast::<Map>() else {
-        return runtime_error(format!(
-            "units must be a map #{{ length: \"mm\", force: \"N\", time: \"s\" }}, got {}",
-            v.type_name()
-        ));
-    };
-    for (key, value) in &map {
-        let Ok(name) = value.clone().into_string() else {
-            return runtime_error(format!("units.{key} must be a string"));
-        };
-        if name.contains([',', '"', '[', ']', '\n', '\r']) {
-            return runtime_error(format!(
-                "units.{key} = '{name}' must not contain , \" [ ] or line breaks (it names CSV columns)"
-            ));
-        }
-        match key.as_str() {
-            "length" => into.length = name,
-            "force" => into.force = name,
-            "time" => into.time = name,
-            other => {
-                return runtime_error(format!(
-                    "unknown unit '{other}' (known: length, force, time)"
-                ))
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Output knobs of the script layer.
-struct Knobs {
-    frames: FrameKnobs,
-    checkpoint_every: usize,
-    /// `--max-increments`: a larger `increments` setting is refused.
-    max_increments: usize,
-}
-
-fn choice<'a>(v: &Dynamic, key: &str, options: &[&'a str]) -> ScriptResult<&'a str> {
-    let text = v.clone().into_string().unwrap_or_else(|t| format!("({t})"));
-    match options.iter().find(|o| **o == text) {
-        Some(o) => Ok(o),
-        None => runtime_error(format!(
-            "{key} = '{text}' must be one of {}",
-            options
-                .iter()
-                .map(|o| format!("\"{o}\""))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )),
-    }
-}
-
-fn flag(v: &Dynamic, key: &str) -> ScriptResult<bool> {
-    v.as_bool()
-        .map_err(|t| format!("{key} must be true or false, got {t}"))
-        .or_else(runtime_error)
-}
-
-/// Every key `sim.settings(#{ ... })` accepts (its error message and the REPL's completion
-/// list them from here).
-pub const SETTING_KEYS: &[&str] = &[
-    "increments",
-    "end_time",
-    "max_iterations",
-    "max_cutbacks",
-    "force_tolerance",
-    "force_abs_tolerance",
-    "contact_tolerance",
-    "output_every",
-    "output_interval",
-    "frame_points",
-    "units",
-    "model_fraction",
-    "checkpoint_every",
-    "curvature",
-    "frame",
-    "enforcement",
-    "r_fraction",
-    "friction_update",
-    "eliminate_multipliers",
-    "linear_solver",
-    "extrapolate",
-    "status_prediction",
-    "threads",
-    "kinematics",
-    "fbar",
-    "element",
-    "thickness_points",
-    "step_control",
-    "dt_min",
-    "dt_max",
-    "dt_initial",
-    "max_plastic_strain_increment",
-    "max_rotation_increment",
-    "max_slip_increment",
-    "target_iterations",
-    "step_growth",
-    "line_search",
-    "anti_cycling",
-    "cycle_flips",
-    "rollback_depth",
-    "last_resort",
-];
-
-fn apply_settings(s: &mut SolverSettings, st: &mut Knobs, spec: &Map) -> ScriptResult<()> {
-    for (key, v) in spec {
-        let num = |what: &str| number(v, what);
-        let count = |what: &str| -> ScriptResult<usize> {
-            let x = number(v, what)?;
-            if x >= 0.0 && x.fract() == 0.0 && x < 1e12 {
-                Ok(x as usize)
-            } else {
-                fail(Error::input(what, x, "must be a whole number >= 0"))
-            }
-        };
-        let step = &mut s.stepping;
-        match key.as_str() {
-            "step_control" => {
-                step.mode = match choice(v, key, &["fixed", "adaptive"])? {
-                    "fixed" => StepMode::Fixed,
-                    _ => StepMode::Adaptive,
-                }
-            }
-            "dt_min" => step.dt_min = Some(num("dt_min")?),
-            "dt_max" => step.dt_max = Some(num("dt_max")?),
-            "dt_initial" => step.dt_initial = Some(num("dt_initial")?),
-            "max_plastic_strain_increment" => step.max_plastic_strain_increment = num(key)?,
-            "max_rotation_increment" => step.max_rotation_increment = num(key)?,
-            "max_slip_increment" => step.max_slip_increment = num(key)?,
-            "target_iterations" => step.target_iterations = count(key)?,
-            "step_growth" => step.growth = num(key)?,
-            "line_search" => step.line_search = flag(v, key)?,
-            "anti_cycling" => {
-                step.anti_cycling = match choice(v, key, &["freeze", "damp", "off"])? {
-                    "freeze" => AntiCycling::Freeze,
-                    "damp" => AntiCycling::Damp,
-                    _ => AntiCycling::Off,
-                }
-            }
-            "cycle_flips" => step.cycle_flips = count(key)?,
-            "status_prediction" => s.status_prediction = count(key)?,
-            "rollback_depth" => step.rollback_depth = count(key)?,
-            "last_resort" => step.last_resort = flag(v, key)?,
-            "r_fraction" => {
-                let f = num(key)?;
-                if !(f > 0.0 && f.is_finite()) {
-                    return fail(Error::input(key, f, "must be > 0"));
-                }
-                s.contact.r_fraction = f;
-            }
-            "checkpoint_every" => st.checkpoint_every = count(key)?,
-            "increments" => {
-                let n = number(v, key)?;
-                let cap = st.max_increments as f64;
-                if !(n >= 1.0 && n <= cap && n.fract() == 0.0) {
-                    return fail(Error::input(
-                        key,
-                        n,
-                        &format!(
-                            "must be a whole number from 1 to {} (raise the cap with --max-increments)",
-                            st.max_increments
-                        ),
-                    ));
-                }
-                s.increments = n as usize;
-            }
-            "end_time" => s.end_time = num("end_time")?,
-            "max_iterations" => s.max_iterations = count(key)?,
-            "max_cutbacks" => s.max_cutbacks = count(key)?,
-            "force_tolerance" => s.force_rel_tol = num("force_tolerance")?,
-            "force_abs_tolerance" => s.force_abs_tol = num("force_abs_tolerance")?,
-            "contact_tolerance" => s.contact_tol = num("contact_tolerance")?,
-            "output_every" => {
-                let n = count("output_every")?;
-                st.frames.off = n == 0;
-                st.frames.cadence = (n > 0).then_some(Cadence::Increments(n));
-            }
-            "output_interval" => {
-                st.frames.off = false;
-                st.frames.cadence = Some(lift(Cadence::interval(num("output_interval")?))?);
-            }
-            "units" => units(v, &mut st.frames.units)?,
-            "model_fraction" => {
-                let f = num("model_fraction")?;
-                if !(f > 0.0 && f <= 1.0) {
-                    return fail(Error::input(
-                        "model_fraction",
-                        f,
-                        "must be in (0, 1] (1/4 for a quarter model)",
-                    ));
-                }
-                st.frames.model_fraction = f;
-            }
-            "frame_points" => {
-                let name = v.clone().into_string().unwrap_or_default();
-                st.frames.points = lift(Configuration::parse(&name))
-                    .map_err(|_| {
-                        format!("frame_points = '{name}' must be \"current\" or \"reference\"")
-                    })
-                    .or_else(runtime_error)?;
-            }
-            "extrapolate" => {
-                s.extrapolate = v
-                    .as_bool()
-                    .map_err(|t| format!("extrapolate must be true or false, got {t}"))
-                    .or_else(runtime_error)?
-            }
-            "threads" => s.threads = count(key)?,
-            "eliminate_multipliers" => {
-                s.eliminate_multipliers = v
-                    .as_bool()
-                    .map_err(|t| format!("eliminate_multipliers must be true or false, got {t}"))
-                    .or_else(runtime_error)?
-            }
-            "linear_solver" => {
-                let name = v.clone().into_string().unwrap_or_default();
-                s.linear_solver =
-                    crate::solver::LinearSolverKind::from_name(&name).or_else(runtime_error)?
-            }
-            "kinematics" => {
-                let name = v.clone().into_string().unwrap_or_default();
-                s.kinematics = lift(crate::element::StrainTheory::from_name(&name))?;
-            }
-            "fbar" => {
-                s.fbar = v
-                    .as_bool()
-                    .map_err(|t| format!("fbar must be true or false, got {t}"))
-                    .or_else(runtime_error)?
-            }
-            "element" => {
-                let name = v.clone().into_string().unwrap_or_default();
-                s.element = lift(crate::element::ElementKind::from_name(&name))?;
-            }
-            "thickness_points" => {
-                s.thickness_points = lift(crate::element::solid_shell::check_thickness_points(
-                    count(key)?,
-                ))?;
-            }
-            "friction_update" => {
-                s.contact.friction_update =
-                    match v.clone().into_string().unwrap_or_default().as_str() {
-                        "explicit" => crate::contact::FrictionUpdate::Explicit,
-                        "implicit" => crate::contact::FrictionUpdate::Implicit,
-                        o => {
-                            return runtime_error(format!(
-                                "friction_update = '{o}' must be \"explicit\" or \"implicit\""
-                            ))
-                        }
-                    }
-            }
-            "curvature" => {
-                s.contact.curvature = v
-                    .as_bool()
-                    .map_err(|t| format!("curvature must be true or false, got {t}"))
-                    .or_else(runtime_error)?
-            }
-            "frame" => {
-                s.contact.frame = match v.clone().into_string().unwrap_or_default().as_str() {
-                    "every_iteration" => FrameUpdate::EveryIteration,
-                    "frozen" => FrameUpdate::Frozen,
-                    o => {
-                        return runtime_error(format!(
-                            "frame = '{o}' must be \"every_iteration\" or \"frozen\""
-                        ))
-                    }
-                }
-            }
-            "enforcement" => {
-                s.contact.enforcement = match v.clone().into_string().unwrap_or_default().as_str() {
-                    "augmented_lagrangian" => Enforcement::AugmentedLagrangian,
-                    "penalty" => Enforcement::Penalty,
-                    o => {
-                        return runtime_error(format!(
-                            "enforcement = '{o}' must be \"augmented_lagrangian\" or \"penalty\""
-                        ))
-                    }
-                }
-            }
-            other => {
-                return runtime_error(format!(
-                    "unknown setting '{other}' (known: {})",
-                    SETTING_KEYS.join(", ")
-                ))
-            }
-        }
-    }
-    for (what, v) in [
-        ("increments", s.increments as f64),
-        ("end_time", s.end_time),
-        ("max_iterations", s.max_iterations as f64),
-    ] {
-        if !(v > 0.0 && v.is_finite()) {
-            return fail(Error::input(what, v, "must be > 0"));
-        }
-    }
-    for (what, v) in [
-        ("force_tolerance", s.force_rel_tol),
-        ("contact_tolerance", s.contact_tol),
-    ] {
-        if v.is_nan() || v <= 0.0 {
-            return fail(Error::input(what, v, "must be > 0"));
-        }
-    }
-    lift(s.stepping.validate(s.end_time))
-}
-
+/// Registers the `Simulation` type and everything scripts do with it, one domain at a
+/// time (each function below says what scripts get; docs/script-api.md, "Simulation",
+/// describes every call).
 pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     engine.register_type_with_name::<ScriptSim>("Simulation");
+    register_setup(engine, &host);
+    register_boundary_conditions(engine);
+    register_contact(engine);
+    register_stepping(engine, &host);
+    register_queries(engine);
+    register_contact_queries(engine);
+    register_checkpoints(engine);
+    register_output(engine, &host);
+}
+
+/// `simulation(mesh, material)`, a new simulation with the host's base settings, and
+/// `sim.settings(#{ ... })` (the keys of [`super::settings::SETTINGS`]), before or between
+/// increments.
+fn register_setup(engine: &mut Engine, host: &Rc<HostOptions>) {
     let h = host.clone();
     engine.register_fn(
         "simulation",
         move |mesh: Mesh, mat: ScriptMaterial| -> ScriptResult<ScriptSim> {
-            let mut model = lift(Model::new(mesh, mat.0))?;
-            let mut knobs = Knobs {
-                frames: FrameKnobs::default(),
-                checkpoint_every: 0,
-                max_increments: h.limits.max_increments,
-            };
-            apply_settings(&mut model.settings, &mut knobs, &h.base_settings)?;
-            let sim = Rc::new(RefCell::new(SimState {
-                model: Some(model),
-                sim: None,
-                output: None,
-                frames: knobs.frames,
-                checkpoint_every: knobs.checkpoint_every,
-                host: h.clone(),
-                started: None,
-                wall_time: None,
-                node_log: Vec::new(),
-                kept: serde_json::Map::new(),
-                checkpoint_due: None,
-                final_saved: None,
-                failure: None,
-                progress: None,
-            }));
-            h.simulations.add(sim.clone());
-            Ok(sim)
+            new_simulation(&h, mesh, mat)
         },
     );
+    engine.register_fn("settings", |s: &mut ScriptSim, spec: Map| {
+        change_settings(s, &spec)
+    });
+}
+
+/// A simulation of `mesh` and `mat`, the host's base settings applied, added to the
+/// host's list of simulations.
+fn new_simulation(
+    host: &Rc<HostOptions>,
+    mesh: Mesh,
+    mat: ScriptMaterial,
+) -> ScriptResult<ScriptSim> {
+    let mut model = lift(Model::new(mesh, mat.0))?;
+    let mut knobs = Knobs {
+        frames: FrameKnobs::default(),
+        checkpoint_every: 0,
+        max_increments: host.limits.max_increments,
+    };
+    apply_settings(&mut model.settings, &mut knobs, &host.base_settings)?;
+    let sim = Rc::new(RefCell::new(SimState {
+        model: Some(model),
+        sim: None,
+        output: None,
+        frames: knobs.frames,
+        checkpoint_every: knobs.checkpoint_every,
+        host: host.clone(),
+        started: None,
+        wall_time: None,
+        node_log: Vec::new(),
+        kept: serde_json::Map::new(),
+        checkpoint_due: None,
+        final_saved: None,
+        failure: None,
+        progress: None,
+    }));
+    host.simulations.add(sim.clone());
+    Ok(sim)
+}
+
+/// `sim.settings(spec)`: into the model, or into a running simulation for its next
+/// increments.
+fn change_settings(s: &mut ScriptSim, spec: &Map) -> ScriptResult<()> {
+    let mut st = s.borrow_mut();
+    let mut knobs = Knobs {
+        frames: st.frames.clone(),
+        checkpoint_every: st.checkpoint_every,
+        max_increments: st.host.limits.max_increments,
+    };
+    if let Some(model) = st.model.as_mut() {
+        apply_settings(&mut model.settings, &mut knobs, spec)?;
+    } else if let Some(sim) = st.sim.as_mut() {
+        // A running simulation (the REPL after a rollback, say) takes new settings
+        // for its next increments.
+        let mut settings = sim.model.settings.clone();
+        apply_settings(&mut settings, &mut knobs, spec)?;
+        lift(sim.change_settings(settings))?;
+    }
+    st.frames = knobs.frames;
+    st.checkpoint_every = knobs.checkpoint_every;
+    Ok(())
+}
+
+/// `sim.fix(set, comps)`, `sim.prescribe(set, comps, value)` and `sim.load(set, force)`,
+/// `sim.load(set, force, scale)`: held components and nodal loads of the model.
+fn register_boundary_conditions(engine: &mut Engine) {
     engine.register_fn(
         "fix",
         |s: &mut ScriptSim, set: &str, comps: &str| -> ScriptResult<()> {
@@ -1040,6 +753,11 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             lift(s.borrow_mut().model_mut()?.add_load(set, f, sched))
         },
     );
+}
+
+/// `sim.add_tool(tool, set)` and `sim.add_tool(tool, set, r)`: contact between a tool and
+/// a node set (a warning for an empty set; a path far beyond the body refused).
+fn register_contact(engine: &mut Engine) {
     engine.register_fn(
         "add_tool",
         |ctx: NativeCallContext, s: &mut ScriptSim, t: Tool, set: &str| -> ScriptResult<()> {
@@ -1062,131 +780,116 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             lift(s.borrow_mut().model_mut()?.add_tool(t, set, Some(r)))
         },
     );
-    engine.register_fn(
-        "settings",
-        |s: &mut ScriptSim, spec: Map| -> ScriptResult<()> {
-            let mut st = s.borrow_mut();
-            let mut knobs = Knobs {
-                frames: st.frames.clone(),
-                checkpoint_every: st.checkpoint_every,
-                max_increments: st.host.limits.max_increments,
-            };
-            if let Some(model) = st.model.as_mut() {
-                apply_settings(&mut model.settings, &mut knobs, &spec)?;
-            } else if let Some(sim) = st.sim.as_mut() {
-                // A running simulation (the REPL after a rollback, say) takes new settings
-                // for its next increments.
-                let mut settings = sim.model.settings.clone();
-                apply_settings(&mut settings, &mut knobs, &spec)?;
-                lift(sim.change_settings(settings))?;
-            }
-            st.frames = knobs.frames;
-            st.checkpoint_every = knobs.checkpoint_every;
-            Ok(())
-        },
-    );
+}
+
+/// `sim.step()` (one increment, its report), `sim.run()` (to the end time, with the
+/// progress bar), `sim.rollback()` and `sim.rollback(n)` (undo converged increments, so
+/// that the REPL can change a setting and step on).
+fn register_stepping(engine: &mut Engine, host: &Rc<HostOptions>) {
     let h = host.clone();
     engine.register_fn(
         "step",
-        move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> {
-            if h.defer_run.get() {
-                // The REPL loading a script that steps itself: loading ends here, with the
-                // scene built and nothing stepped.
-                return Err(Box::new(rhai::EvalAltResult::ErrorTerminated(
-                    Dynamic::from(DEFERRED),
-                    rhai::Position::NONE,
-                )));
-            }
-            let r = advance(&ctx, s)?;
-            let mut st = s.borrow_mut();
-            if st.sim.as_ref().is_some_and(|x| x.is_finished()) {
-                st.finish()?;
-            }
-            Ok(report_map(&r, &tool_names(&st)))
-        },
+        move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> { step(&ctx, s, &h) },
     );
     let h = host.clone();
     engine.register_fn(
         "run",
-        move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> {
-            if h.defer_run.get() {
-                println!(
-                    "(repl) sim.run() deferred: step with sim.step(), or call sim.run() to finish"
-                );
-                return Ok(Map::new());
+        move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> { run(&ctx, s, &h) },
+    );
+    engine.register_fn("rollback", |s: &mut ScriptSim| -> ScriptResult<f64> {
+        rollback(s, 1)
+    });
+    engine.register_fn(
+        "rollback",
+        |s: &mut ScriptSim, n: i64| -> ScriptResult<f64> {
+            if n < 1 {
+                return runtime_error(format!("rollback({n}): the count must be >= 1"));
             }
-            let mut st = s.borrow_mut();
-            st.simulation()?;
-            // Progress in pseudo-time (per mille): the number of adaptive increments is not
-            // known beforehand.
-            let end_time = st.sim.as_ref().expect("started").model.settings.end_time;
-            let bar = h.progress.then(|| {
-                let b = indicatif::ProgressBar::new(1000);
-                b.set_style(
-                    indicatif::ProgressStyle::with_template(
-                        "{bar:40} {percent:>3}% of the time  {msg}  [{elapsed_precise}, ETA {eta}]",
-                    )
-                    .expect("valid template"),
-                );
-                b
-            });
-            st.progress = bar.clone();
-            let mut last = None;
-            drop(st);
-            while !s.borrow().sim.as_ref().expect("started").is_finished() {
-                let r = match advance(&ctx, s) {
-                    Ok(r) => r,
-                    Err(e) => {
-                        if let Some(b) = &bar {
-                            b.abandon_with_message("stopped");
-                        }
-                        s.borrow_mut().progress = None;
-                        return Err(e);
-                    }
-                };
+            rollback(s, n as usize)
+        },
+    );
+}
+
+/// `sim.step()`: one increment and its report; the summary is written when it ends the
+/// run.
+fn step(ctx: &NativeCallContext, s: &mut ScriptSim, host: &HostOptions) -> ScriptResult<Map> {
+    if host.defer_run.get() {
+        // The REPL loading a script that steps itself: loading ends here, with the
+        // scene built and nothing stepped.
+        return Err(Box::new(rhai::EvalAltResult::ErrorTerminated(
+            Dynamic::from(DEFERRED),
+            rhai::Position::NONE,
+        )));
+    }
+    let r = advance(ctx, s)?;
+    let mut st = s.borrow_mut();
+    if st.sim.as_ref().is_some_and(|x| x.is_finished()) {
+        st.finish()?;
+    }
+    Ok(report_map(&r, &tool_names(&st)))
+}
+
+/// `sim.run()`: increments to the end time (a progress bar under `tribo run`), then the
+/// summary; returns the last increment's report.
+fn run(ctx: &NativeCallContext, s: &mut ScriptSim, host: &HostOptions) -> ScriptResult<Map> {
+    if host.defer_run.get() {
+        println!("(repl) sim.run() deferred: step with sim.step(), or call sim.run() to finish");
+        return Ok(Map::new());
+    }
+    let mut st = s.borrow_mut();
+    st.simulation()?;
+    let end_time = st.sim.as_ref().expect("started").model.settings.end_time;
+    let bar = host.progress.then(progress_bar);
+    st.progress = bar.clone();
+    let mut last = None;
+    drop(st);
+    while !s.borrow().sim.as_ref().expect("started").is_finished() {
+        let r = match advance(ctx, s) {
+            Ok(r) => r,
+            Err(e) => {
                 if let Some(b) = &bar {
-                    b.set_position((1000.0 * r.time / end_time).round() as u64);
-                    b.set_message(format!(
-                        "increment {}, t = {:.4}, dt = {:.3e}, {} Newton iterations",
-                        r.index, r.time, r.dt, r.iterations
-                    ));
+                    b.abandon_with_message("stopped");
                 }
-                last = Some(r);
+                s.borrow_mut().progress = None;
+                return Err(e);
             }
-            if let Some(b) = &bar {
-                b.finish();
-            }
-            let mut st = s.borrow_mut();
-            st.progress = None;
-            st.finish()?;
-            let names = tool_names(&st);
-            Ok(last.map(|r| report_map(&r, &names)).unwrap_or_default())
-        },
+        };
+        if let Some(b) = &bar {
+            b.set_position((1000.0 * r.time / end_time).round() as u64);
+            b.set_message(format!(
+                "increment {}, t = {:.4}, dt = {:.3e}, {} Newton iterations",
+                r.index, r.time, r.dt, r.iterations
+            ));
+        }
+        last = Some(r);
+    }
+    if let Some(b) = &bar {
+        b.finish();
+    }
+    let mut st = s.borrow_mut();
+    st.progress = None;
+    st.finish()?;
+    let names = tool_names(&st);
+    Ok(last.map(|r| report_map(&r, &names)).unwrap_or_default())
+}
+
+/// The bar of `sim.run()`: progress in pseudo-time (per mille), since the number of
+/// adaptive increments is not known beforehand.
+fn progress_bar() -> indicatif::ProgressBar {
+    let b = indicatif::ProgressBar::new(1000);
+    b.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {percent:>3}% of the time  {msg}  [{elapsed_precise}, ETA {eta}]",
+        )
+        .expect("valid template"),
     );
-    // The script's own values across a restart: kept in every checkpoint, restored with it.
-    engine.register_fn(
-        "keep",
-        |s: &mut ScriptSim, name: &str, value: Dynamic| -> ScriptResult<()> {
-            if name.is_empty() {
-                return runtime_error("sim.keep needs a non-empty name");
-            }
-            let json = super::convert::to_json(&value, name, super::convert::JsonUse::Checkpoint)?;
-            s.borrow_mut().keep(name, json);
-            Ok(())
-        },
-    );
-    engine.register_fn(
-        "kept",
-        |s: &mut ScriptSim, name: &str| -> ScriptResult<Dynamic> {
-            let mut st = s.borrow_mut();
-            // Starting the simulation loads the restart checkpoint, if any.
-            st.simulation()?;
-            Ok(st
-                .kept(name)
-                .map(super::convert::from_json)
-                .unwrap_or(Dynamic::UNIT))
-        },
-    );
+    b
+}
+
+/// `sim.time`, `sim.finished()`, `sim.tool_force(name)`, `sim.tool_offset(name)`,
+/// `sim.tool_position(name)`, `sim.displacement(node)`, `sim.reaction(set)` and
+/// `sim.history()`: the state of the simulation (a query starts it).
+fn register_queries(engine: &mut Engine) {
     engine.register_get("time", |s: &mut ScriptSim| {
         s.borrow().sim.as_ref().map(|x| x.time()).unwrap_or(0.0)
     });
@@ -1242,41 +945,26 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             Ok(array3(&lift(sim.reaction(&nodes))?))
         },
     );
-    // One map per candidate node of a tool: node, position, status, gap, forces, pressure, history.
-    engine.register_fn(
-        "contact_nodes",
-        |s: &mut ScriptSim, name: &str| -> ScriptResult<Array> {
-            let mut st = s.borrow_mut();
-            let sim = st.simulation()?;
-            let c = lift(sim.model.tool_index(name))?;
-            let contact = &sim.model.contacts[c];
-            let mut out = Array::new();
-            for (k, state) in sim.contact_states(c).iter().enumerate() {
-                let node = contact.candidates[k];
-                let x = sim.model.mesh.nodes[node] + sim.displacement(node);
-                let mut m = Map::new();
-                m.insert("node".into(), Dynamic::from(node as i64));
-                m.insert("x".into(), Dynamic::from(array3(&x)));
-                m.insert(
-                    "status".into(),
-                    Dynamic::from(format!("{:?}", state.status).to_lowercase()),
-                );
-                m.insert("gap".into(), Dynamic::from(state.gap));
-                m.insert("lambda_n".into(), Dynamic::from(state.lambda_n()));
-                m.insert("lambda_t".into(), Dynamic::from(state.lambda_t_norm()));
-                m.insert("area".into(), Dynamic::from(contact.areas[k]));
-                m.insert(
-                    "pressure".into(),
-                    Dynamic::from(-state.lambda_n() / contact.areas[k].max(f64::MIN_POSITIVE)),
-                );
-                m.insert("work".into(), Dynamic::from(state.work));
-                m.insert("slip".into(), Dynamic::from(state.slip));
-                m.insert("mu".into(), Dynamic::from(state.mu));
-                out.push(Dynamic::from(m));
-            }
-            Ok(out)
-        },
-    );
+    engine.register_fn("history", |s: &mut ScriptSim| -> Array {
+        let st = s.borrow();
+        let names = tool_names(&st);
+        st.sim
+            .as_ref()
+            .map(|sim| {
+                sim.history
+                    .iter()
+                    .map(|r| Dynamic::from(report_map(r, &names)))
+                    .collect()
+            })
+            .unwrap_or_default()
+    });
+}
+
+/// `sim.contact_nodes(name)`, `sim.contact_node(name, node)` and
+/// `sim.node_history(name, node)`: a tool's candidate nodes now, one of them, and one's
+/// work, mu and status over the converged increments.
+fn register_contact_queries(engine: &mut Engine) {
+    engine.register_fn("contact_nodes", contact_nodes);
     // The state of one mesh node against a tool (a map as in contact_nodes).
     engine.register_fn(
         "contact_node",
@@ -1293,67 +981,80 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 .or_else(runtime_error)
         },
     );
-    // A node's history against a tool: one map per converged increment.
-    engine.register_fn(
-        "node_history",
-        |s: &mut ScriptSim, name: &str, node: i64| -> ScriptResult<Array> {
-            let mut st = s.borrow_mut();
-            let sim = st.simulation()?;
-            let c = lift(sim.model.tool_index(name))?;
-            let Some(k) = sim.model.contacts[c]
-                .candidates
-                .iter()
-                .position(|&n| n as i64 == node)
-            else {
-                return runtime_error(format!(
-                    "node {node} is not a contact candidate of tool '{name}'"
-                ));
-            };
-            Ok(st
-                .node_log
-                .iter()
-                .map(|(index, time, tools)| {
-                    let [work, mu, status] = tools[c][k];
-                    let mut m = Map::new();
-                    m.insert("increment".into(), Dynamic::from(*index as i64));
-                    m.insert("time".into(), Dynamic::from(*time));
-                    m.insert("work".into(), Dynamic::from(work));
-                    m.insert("mu".into(), Dynamic::from(mu));
-                    m.insert(
-                        "status".into(),
-                        Dynamic::from(["gap", "stick", "slip"][status as usize].to_string()),
-                    );
-                    Dynamic::from(m)
-                })
-                .collect())
-        },
-    );
-    engine.register_fn("history", |s: &mut ScriptSim| -> Array {
-        let st = s.borrow();
-        let names = tool_names(&st);
-        st.sim
-            .as_ref()
-            .map(|sim| {
-                sim.history
-                    .iter()
-                    .map(|r| Dynamic::from(report_map(r, &names)))
-                    .collect()
-            })
-            .unwrap_or_default()
-    });
-    // Undo the last converged increment(s): the REPL can then change a setting and step on.
-    engine.register_fn("rollback", |s: &mut ScriptSim| -> ScriptResult<f64> {
-        rollback(s, 1)
-    });
-    engine.register_fn(
-        "rollback",
-        |s: &mut ScriptSim, n: i64| -> ScriptResult<f64> {
-            if n < 1 {
-                return runtime_error(format!("rollback({n}): the count must be >= 1"));
-            }
-            rollback(s, n as usize)
-        },
-    );
+    engine.register_fn("node_history", node_history);
+}
+
+/// One map per candidate node of a tool: node, position, status, gap, forces, area,
+/// pressure, work, slip, mu.
+fn contact_nodes(s: &mut ScriptSim, name: &str) -> ScriptResult<Array> {
+    let mut st = s.borrow_mut();
+    let sim = st.simulation()?;
+    let c = lift(sim.model.tool_index(name))?;
+    let contact = &sim.model.contacts[c];
+    let mut out = Array::new();
+    for (k, state) in sim.contact_states(c).iter().enumerate() {
+        let node = contact.candidates[k];
+        let x = sim.model.mesh.nodes[node] + sim.displacement(node);
+        let mut m = Map::new();
+        m.insert("node".into(), Dynamic::from(node as i64));
+        m.insert("x".into(), Dynamic::from(array3(&x)));
+        m.insert(
+            "status".into(),
+            Dynamic::from(format!("{:?}", state.status).to_lowercase()),
+        );
+        m.insert("gap".into(), Dynamic::from(state.gap));
+        m.insert("lambda_n".into(), Dynamic::from(state.lambda_n()));
+        m.insert("lambda_t".into(), Dynamic::from(state.lambda_t_norm()));
+        m.insert("area".into(), Dynamic::from(contact.areas[k]));
+        m.insert(
+            "pressure".into(),
+            Dynamic::from(-state.lambda_n() / contact.areas[k].max(f64::MIN_POSITIVE)),
+        );
+        m.insert("work".into(), Dynamic::from(state.work));
+        m.insert("slip".into(), Dynamic::from(state.slip));
+        m.insert("mu".into(), Dynamic::from(state.mu));
+        out.push(Dynamic::from(m));
+    }
+    Ok(out)
+}
+
+/// A node's history against a tool: one map per converged increment.
+fn node_history(s: &mut ScriptSim, name: &str, node: i64) -> ScriptResult<Array> {
+    let mut st = s.borrow_mut();
+    let sim = st.simulation()?;
+    let c = lift(sim.model.tool_index(name))?;
+    let Some(k) = sim.model.contacts[c]
+        .candidates
+        .iter()
+        .position(|&n| n as i64 == node)
+    else {
+        return runtime_error(format!(
+            "node {node} is not a contact candidate of tool '{name}'"
+        ));
+    };
+    Ok(st
+        .node_log
+        .iter()
+        .map(|(index, time, tools)| {
+            let [work, mu, status] = tools[c][k];
+            let mut m = Map::new();
+            m.insert("increment".into(), Dynamic::from(*index as i64));
+            m.insert("time".into(), Dynamic::from(*time));
+            m.insert("work".into(), Dynamic::from(work));
+            m.insert("mu".into(), Dynamic::from(mu));
+            m.insert(
+                "status".into(),
+                Dynamic::from(["gap", "stick", "slip"][status as usize].to_string()),
+            );
+            Dynamic::from(m)
+        })
+        .collect())
+}
+
+/// `sim.checkpoint(path)` (the committed state, now) and the script's own values across a
+/// restart: `sim.keep(name, value)`, kept in every checkpoint, and `sim.kept(name)`,
+/// restored with it.
+fn register_checkpoints(engine: &mut Engine) {
     engine.register_fn(
         "checkpoint",
         |s: &mut ScriptSim, path: &str| -> ScriptResult<String> {
@@ -1370,6 +1071,34 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             }
         },
     );
+    engine.register_fn(
+        "keep",
+        |s: &mut ScriptSim, name: &str, value: Dynamic| -> ScriptResult<()> {
+            if name.is_empty() {
+                return runtime_error("sim.keep needs a non-empty name");
+            }
+            let json = super::convert::to_json(&value, name, super::convert::JsonUse::Checkpoint)?;
+            s.borrow_mut().keep(name, json);
+            Ok(())
+        },
+    );
+    engine.register_fn(
+        "kept",
+        |s: &mut ScriptSim, name: &str| -> ScriptResult<Dynamic> {
+            let mut st = s.borrow_mut();
+            // Starting the simulation loads the restart checkpoint, if any.
+            st.simulation()?;
+            Ok(st
+                .kept(name)
+                .map(super::convert::from_json)
+                .unwrap_or(Dynamic::UNIT))
+        },
+    );
+}
+
+/// `sim.write_frame()` (a VTK frame now) and `write_text(path, text)` (a text file below
+/// the run's output folder; absolute paths and '..' are refused).
+fn register_output(engine: &mut Engine, host: &Rc<HostOptions>) {
     engine.register_fn("write_frame", |s: &mut ScriptSim| -> ScriptResult<()> {
         let mut st = s.borrow_mut();
         st.simulation()?;
@@ -1380,7 +1109,6 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
         }
     });
     let h = host.clone();
-    // A text file below the run's output folder (absolute paths and '..' are refused).
     engine.register_fn(
         "write_text",
         move |path: &str, text: &str| -> ScriptResult<String> {
@@ -1396,6 +1124,8 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     );
 }
 
+/// Undoes the last `n` converged increments (the node histories and the output files
+/// with them); returns the time reached.
 fn rollback(s: &mut ScriptSim, n: usize) -> ScriptResult<f64> {
     let mut st = s.borrow_mut();
     let SimState {
@@ -1414,62 +1144,4 @@ fn rollback(s: &mut ScriptSim, n: usize) -> ScriptResult<f64> {
         lift(out.rollback(sim))?;
     }
     Ok(t)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn settings_error(key: &str) -> String {
-        let mut knobs = Knobs {
-            frames: FrameKnobs::default(),
-            checkpoint_every: 0,
-            max_increments: usize::MAX,
-        };
-        let mut spec = Map::new();
-        spec.insert(key.into(), Dynamic::UNIT);
-        match apply_settings(&mut SolverSettings::default(), &mut knobs, &spec) {
-            Ok(()) => String::new(),
-            Err(e) => e.to_string(),
-        }
-    }
-
-    /// `SETTING_KEYS` (the error message's and the REPL's list) and the keys
-    /// `apply_settings` reads are kept by hand side by side: every listed key must be one it
-    /// knows (a unit value is refused by that key's own check, never as an unknown setting).
-    #[test]
-    fn every_listed_setting_key_is_read() {
-        assert!(settings_error("no_such_key").contains("unknown setting"));
-        for key in SETTING_KEYS {
-            let e = settings_error(key);
-            assert!(!e.contains("unknown setting"), "{key}: {e}");
-        }
-    }
-
-    /// The other direction: every key `apply_settings` matches is listed, so the error
-    /// message and the REPL's completion offer it. Read from this file's source: the
-    /// match arms at the indentation of the first key (rustfmt keeps it; nested matches
-    /// over a key's values are indented deeper).
-    #[test]
-    fn every_read_setting_key_is_listed() {
-        let source = include_str!("api_sim.rs");
-        let start = source.find("fn apply_settings(").unwrap();
-        let end = start + source[start..].find("other =>").unwrap();
-        let body = &source[start..end];
-        let first = body.find("\"step_control\" =>").unwrap();
-        let indent = first - body[..first].rfind('\n').unwrap() - 1;
-        let arms: Vec<&str> = body
-            .lines()
-            .filter(|l| l.len() > indent && l[..indent].trim().is_empty())
-            .filter_map(|l| l[indent..].strip_prefix('"'))
-            .filter_map(|l| l.split_once("\" =>").map(|(key, _)| key))
-            .collect();
-        assert!(arms.len() >= 30, "{arms:?}");
-        for key in arms {
-            assert!(
-                SETTING_KEYS.contains(&key),
-                "'{key}' is read but not in SETTING_KEYS"
-            );
-        }
-    }
 }

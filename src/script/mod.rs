@@ -17,9 +17,11 @@ mod api_tools;
 mod convert;
 pub mod limits;
 pub mod repl;
+mod settings;
 mod stdlib;
 
-pub use api_sim::{ScriptSim, Simulations, DEFERRED, SETTING_KEYS};
+pub use api_sim::{ScriptSim, Simulations, DEFERRED};
+pub use settings::SETTING_KEYS;
 
 use crate::paths::ReadPolicy;
 use crate::{Error, Result};
