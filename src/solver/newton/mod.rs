@@ -550,11 +550,7 @@ impl Newton<'_> {
         settings.status_prediction = prediction;
         settings.max_iterations = max_iterations;
         let step = &settings.stepping;
-        let frozen = match settings.contact.frame {
-            FrameUpdate::EveryIteration => None,
-            FrameUpdate::Frozen => Some(self.frozen_frames(t_new)),
-        };
-        let mut ctx = self.context(t_new, frozen);
+        let mut ctx = self.increment_context(t_new, settings.contact.frame);
         let n_u = 3 * self.dofs.n_nodes;
         let weights = self.merit_weights();
         let guard = DivergenceGuard::new(self, attempt);
@@ -688,6 +684,16 @@ impl Newton<'_> {
             line_search_cuts,
             element_memory: ctx.element_memory.into_inner(),
         })
+    }
+
+    /// The evaluation context of the increment to `t_new`, with the contact frames of the
+    /// committed state kept through it under `FrameUpdate::Frozen`.
+    fn increment_context(&self, t_new: f64, frame: FrameUpdate) -> IncrementContext<'_> {
+        let frozen = match frame {
+            FrameUpdate::EveryIteration => None,
+            FrameUpdate::Frozen => Some(self.frozen_frames(t_new)),
+        };
+        self.context(t_new, frozen)
     }
 
     /// Anti-cycling's watch over every (tool, candidate) pair's status.
