@@ -246,9 +246,59 @@ pub fn faces_from_iges(source: &str, text: &str) -> Result<Vec<Face>> {
     iges.faces()
 }
 
+/// An input error at `source:line`.
+fn input_error(source: &str, line: usize, message: &str) -> Error {
+    Error::Input(format!("{source}:{line}: {message}"))
+}
+
+/// The global section's parameter and record delimiters: its first two parameters in the
+/// `1H,` form (`1H,,1H;` names `,` and `;`), or the defaults `,` and `;` where a field is
+/// empty or not of that form.
+fn global_delimiters(g: &str) -> (char, char) {
+    // Parameter and record delimiters: "1H," forms, or defaults when the field is empty.
+    let mut chars = g.chars();
+    let (delimiter, rest) = match (chars.next(), chars.next(), chars.next()) {
+        (Some('1'), Some('H'), Some(c)) => (c, &g[3..]),
+        _ => (',', g),
+    };
+    let rest = rest.strip_prefix(delimiter).unwrap_or(rest);
+    let record = {
+        let mut c = rest.chars();
+        match (c.next(), c.next(), c.next()) {
+            (Some('1'), Some('H'), Some(r)) => r,
+            _ => ';',
+        }
+    };
+    (delimiter, record)
+}
+
 impl<'a> Iges<'a> {
     fn parse(source: &'a str, text: &'a str) -> Result<Iges<'a>> {
-        let fail = |line: usize, m: &str| Error::Input(format!("{source}:{line}: {m}"));
+        let [_, global, directory, data, terminate] = Self::sections(source, text)?;
+        Self::check_terminate(source, text, &terminate, directory.len(), data.len())?;
+        if global.is_empty() {
+            return Err(input_error(source, 1, "no global (G) section"));
+        }
+        let g: String = global.iter().map(|(_, s)| *s).collect();
+        let (delimiter, record) = global_delimiters(&g);
+        let to_mm = Self::global_scale(source, &global, &g, delimiter, record)?;
+        let entries = Self::directory_entries(source, &directory)?;
+        Ok(Iges {
+            source,
+            entries,
+            data: data.iter().map(|(l, s)| (*l, &s[..64])).collect(),
+            delimiter,
+            record,
+            to_mm,
+        })
+    }
+
+    /// The lines of the five sections (start, global, directory, parameter data,
+    /// terminate), each as (physical line, columns 1-72), blank lines skipped. Fails on a
+    /// line that is not fixed-format ASCII (80 columns, the section letter in column 73),
+    /// on an unknown section letter and on sections out of order.
+    fn sections(source: &str, text: &'a str) -> Result<[Vec<(usize, &'a str)>; 5]> {
+        let fail = |line: usize, m: &str| input_error(source, line, m);
         let mut sections: [Vec<(usize, &str)>; 5] = Default::default();
         let order = ['S', 'G', 'D', 'P', 'T'];
         let mut current = 0;
@@ -281,7 +331,19 @@ impl<'a> Iges<'a> {
             current = s;
             sections[s].push((line, &raw[..72]));
         }
-        let [_, global, directory, data, terminate] = sections;
+        Ok(sections)
+    }
+
+    /// Checks that the file is whole: the terminate section exists, and the counts of D and
+    /// P lines it announces (`"S      1G      4D    123P    456"`) are the lines read.
+    fn check_terminate(
+        source: &str,
+        text: &str,
+        terminate: &[(usize, &str)],
+        directory_lines: usize,
+        data_lines: usize,
+    ) -> Result<()> {
+        let fail = |line: usize, m: &str| input_error(source, line, m);
         let last_line = text.lines().count();
         if terminate.is_empty() {
             return Err(fail(
@@ -291,7 +353,7 @@ impl<'a> Iges<'a> {
         }
         // T: "S      1G      4D    123P    456" - counts of each section's lines.
         let t = terminate[0].1;
-        for (k, (letter, lines)) in [('D', directory.len()), ('P', data.len())]
+        for (k, (letter, lines)) in [('D', directory_lines), ('P', data_lines)]
             .iter()
             .enumerate()
         {
@@ -308,30 +370,28 @@ impl<'a> Iges<'a> {
                 ));
             }
         }
-        if global.is_empty() {
-            return Err(fail(1, "no global (G) section"));
-        }
-        let g: String = global.iter().map(|(_, s)| *s).collect();
-        // Parameter and record delimiters: "1H," forms, or defaults when the field is empty.
-        let mut chars = g.chars();
-        let (delimiter, rest) = match (chars.next(), chars.next(), chars.next()) {
-            (Some('1'), Some('H'), Some(c)) => (c, &g[3..]),
-            _ => (',', &g[..]),
-        };
-        let rest = rest.strip_prefix(delimiter).unwrap_or(rest);
-        let record = {
-            let mut c = rest.chars();
-            match (c.next(), c.next(), c.next()) {
-                (Some('1'), Some('H'), Some(r)) => r,
-                _ => ';',
-            }
-        };
+        Ok(())
+    }
+
+    /// Millimetres per model unit, `unit / model_scale`, from the global section's units
+    /// flag (parameter 14, with the unit name of parameter 15 for flag 3) and model space
+    /// scale (parameter 13; both defaulted when absent). `global` are the G lines, `g`
+    /// their text joined. Fails, naming the G line, on an unknown unit or a scale that is
+    /// not positive.
+    fn global_scale(
+        source: &str,
+        global: &[(usize, &str)],
+        g: &str,
+        delimiter: char,
+        record: char,
+    ) -> Result<f64> {
+        let fail = |line: usize, m: &str| input_error(source, line, m);
         let Tokens {
             tokens,
             strings,
             starts,
             ..
-        } = tokenize(&g, delimiter, record);
+        } = tokenize(g, delimiter, record);
         // The G line holding global parameter k (1-based).
         let line_of = |k: usize| {
             let offset = starts.get(k - 1).copied().unwrap_or(0);
@@ -364,6 +424,15 @@ impl<'a> Iges<'a> {
                 &format!("global parameter 13 (model space scale) = {model_scale} must be > 0"),
             ));
         }
+        Ok(unit / model_scale)
+    }
+
+    /// The directory entries, one per pair of D lines: entity type, parameter data pointer
+    /// and transformation matrix from the first line, parameter line count and form number
+    /// from the second. Fails on an odd number of D lines (a truncated entry), a field that
+    /// is not an integer and a negative pointer or count.
+    fn directory_entries(source: &str, directory: &[(usize, &str)]) -> Result<Vec<Entry>> {
+        let fail = |line: usize, m: &str| input_error(source, line, m);
         if directory.len() % 2 != 0 {
             return Err(fail(
                 directory.last().map_or(1, |d| d.0),
@@ -410,14 +479,7 @@ impl<'a> Iges<'a> {
                 file_line: l1,
             });
         }
-        Ok(Iges {
-            source,
-            entries,
-            data: data.iter().map(|(l, s)| (*l, &s[..64])).collect(),
-            delimiter,
-            record,
-            to_mm: unit / model_scale,
-        })
+        Ok(entries)
     }
 
     /// The entry a directory pointer (odd D line number) names.

@@ -23,85 +23,11 @@ use mshio::ElementType;
 /// Reads a Gmsh MSH 4.1 file from its bytes; `file` names it in messages.
 pub fn read_gmsh(bytes: &[u8], file: &str) -> Result<Mesh> {
     let ascii = is_ascii_format(bytes);
-    let msh = mshio::parse_msh_bytes(bytes).map_err(|e| {
-        let kind = e
-            .first_msh_error()
-            .map_or_else(|| "not a Gmsh MSH 4.1 file".to_string(), |k| k.to_string());
-        let contexts: Vec<String> = e
-            .filter_msh_errors()
-            .filter_map(|(_, k)| k.context().map(str::to_string))
-            .collect();
-        let at = e
-            .backtrace
-            .first()
-            .map(|(rest, _)| bytes.len() - rest.len())
-            .unwrap_or(0);
-        let place = if ascii {
-            format!("{file}:{}", line_of(bytes, at))
-        } else {
-            format!("{file} (byte {at})")
-        };
-        let within = if contexts.is_empty() {
-            String::new()
-        } else {
-            format!(" (in {})", contexts.join(", in "))
-        };
-        Error::Input(format!("{place}: {kind}{within}"))
-    })?;
-
+    let msh = mshio::parse_msh_bytes(bytes).map_err(|e| parse_error(&e, bytes, file, ascii))?;
     let names = physical_names(bytes, file)?;
-    // (dim, entity tag) -> physical tags.
-    let mut physical: HashMap<(i32, i32), Vec<i32>> = HashMap::new();
-    if let Some(ent) = &msh.data.entities {
-        for p in &ent.points {
-            physical.insert((0, p.tag), p.physical_tags.clone());
-        }
-        for c in &ent.curves {
-            physical.insert((1, c.tag), c.physical_tags.clone());
-        }
-        for s in &ent.surfaces {
-            physical.insert((2, s.tag), s.physical_tags.clone());
-        }
-        for v in &ent.volumes {
-            physical.insert((3, v.tag), v.physical_tags.clone());
-        }
-    }
-    let group_name = |dim: i32, tag: i32| {
-        names
-            .get(&(dim, tag.abs()))
-            .cloned()
-            .unwrap_or_else(|| format!("physical {}", tag.abs()))
-    };
-
+    let physical = entity_physical_tags(&msh);
     let mut out = Imported::default();
-    let mut index_of_tag: HashMap<u64, usize> = HashMap::new();
-    let mut dense_min: Option<u64> = None;
-    if let Some(nodes) = &msh.data.nodes {
-        for block in &nodes.node_blocks {
-            if let Some(tags) = &block.node_tags {
-                for (&tag, &k) in tags {
-                    index_of_tag.insert(tag, out.nodes.len() + k);
-                }
-            } else {
-                dense_min = Some(nodes.min_node_tag);
-            }
-            out.nodes
-                .extend(block.nodes.iter().map(|n| Vec3::new(n.x, n.y, n.z)));
-        }
-    }
-    let node_count = out.nodes.len();
-    let node_index = |tag: u64| -> Result<usize> {
-        let k = match dense_min {
-            Some(min) => tag.checked_sub(min).map(|k| k as usize),
-            None => index_of_tag.get(&tag).copied(),
-        };
-        k.filter(|&k| k < node_count).ok_or_else(|| {
-            Error::Input(format!(
-                "{file}: an element names node {tag}, which the file does not define"
-            ))
-        })
-    };
-
+    let nodes = read_nodes(&msh, &mut out);
     let block_lines = if ascii {
         element_block_lines(bytes)
     } else {
@@ -120,57 +46,207 @@ pub fn read_gmsh(bytes: &[u8], file: &str) -> Result<Mesh> {
         };
         let groups: Vec<String> = physical
             .get(&(dim, block.entity_tag))
-            .map(|tags| tags.iter().map(|&t| group_name(dim, t)).collect())
+            .map(|tags| tags.iter().map(|&t| group_name(&names, dim, t)).collect())
             .unwrap_or_default();
-        let ty = block.element_type;
-        match ty {
-            ElementType::Hex8 => {
-                for el in &block.elements {
-                    let mut hex = [0usize; 8];
-                    for (k, &tag) in el.nodes.iter().take(8).enumerate() {
-                        hex[k] = node_index(tag)?;
-                    }
-                    let e = out.hexes.len();
-                    out.hexes.push(hex);
-                    out.hex_origin
-                        .push(format!("{where_}: hexahedron {}", el.element_tag));
-                    for g in &groups {
-                        out.element_sets.entry(g.clone()).or_default().push(e);
-                        out.node_sets.entry(g.clone()).or_default().extend(hex);
-                    }
+        add_element_block(block, &where_, &groups, &nodes, file, &mut out)?;
+    }
+    out.build(file)
+}
+
+/// The message of a file `mshio` cannot parse: the first MSH error's kind (or "not a Gmsh
+/// MSH 4.1 file"), where it happened (`file:line` in an ASCII file, the byte offset in a
+/// binary one) and the sections it happened within.
+fn parse_error(e: &mshio::MshParserError<&[u8]>, bytes: &[u8], file: &str, ascii: bool) -> Error {
+    let kind = e
+        .first_msh_error()
+        .map_or_else(|| "not a Gmsh MSH 4.1 file".to_string(), |k| k.to_string());
+    let contexts: Vec<String> = e
+        .filter_msh_errors()
+        .filter_map(|(_, k)| k.context().map(str::to_string))
+        .collect();
+    let at = e
+        .backtrace
+        .first()
+        .map(|(rest, _)| bytes.len() - rest.len())
+        .unwrap_or(0);
+    let place = if ascii {
+        format!("{file}:{}", line_of(bytes, at))
+    } else {
+        format!("{file} (byte {at})")
+    };
+    let within = if contexts.is_empty() {
+        String::new()
+    } else {
+        format!(" (in {})", contexts.join(", in "))
+    };
+    Error::Input(format!("{place}: {kind}{within}"))
+}
+
+/// The physical tags of every geometric entity: (dim, entity tag) -> physical tags, from
+/// the `$Entities` section (empty without one).
+fn entity_physical_tags(msh: &mshio::MshFile<u64, i32, f64>) -> HashMap<(i32, i32), Vec<i32>> {
+    let mut physical: HashMap<(i32, i32), Vec<i32>> = HashMap::new();
+    if let Some(ent) = &msh.data.entities {
+        for p in &ent.points {
+            physical.insert((0, p.tag), p.physical_tags.clone());
+        }
+        for c in &ent.curves {
+            physical.insert((1, c.tag), c.physical_tags.clone());
+        }
+        for s in &ent.surfaces {
+            physical.insert((2, s.tag), s.physical_tags.clone());
+        }
+        for v in &ent.volumes {
+            physical.insert((3, v.tag), v.physical_tags.clone());
+        }
+    }
+    physical
+}
+
+/// The set name of physical group `tag` (of dimension `dim`; a negative tag, an oriented
+/// reference, names the same group): its `$PhysicalNames` name, or `"physical <tag>"`.
+fn group_name(names: &BTreeMap<(i32, i32), String>, dim: i32, tag: i32) -> String {
+    names
+        .get(&(dim, tag.abs()))
+        .cloned()
+        .unwrap_or_else(|| format!("physical {}", tag.abs()))
+}
+
+/// How element node tags map to node indices ([`NodeTags::index`]).
+struct NodeTags {
+    /// Tag -> index, for blocks that list their tags.
+    index_of_tag: HashMap<u64, usize>,
+    /// The smallest tag, where `mshio` dropped dense tags (tag `min + k` is node `k`).
+    dense_min: Option<u64>,
+    /// Number of nodes read.
+    count: usize,
+}
+
+impl NodeTags {
+    /// The index of the node of `tag`; an error naming `file` if the file defines no such
+    /// node.
+    fn index(&self, tag: u64, file: &str) -> Result<usize> {
+        let k = match self.dense_min {
+            Some(min) => tag.checked_sub(min).map(|k| k as usize),
+            None => self.index_of_tag.get(&tag).copied(),
+        };
+        k.filter(|&k| k < self.count).ok_or_else(|| {
+            Error::Input(format!(
+                "{file}: an element names node {tag}, which the file does not define"
+            ))
+        })
+    }
+}
+
+/// Appends the `$Nodes` section's nodes to `out.nodes`, in file order, and returns how
+/// their tags map to indices.
+fn read_nodes(msh: &mshio::MshFile<u64, i32, f64>, out: &mut Imported) -> NodeTags {
+    let mut index_of_tag: HashMap<u64, usize> = HashMap::new();
+    let mut dense_min: Option<u64> = None;
+    if let Some(nodes) = &msh.data.nodes {
+        for block in &nodes.node_blocks {
+            if let Some(tags) = &block.node_tags {
+                for (&tag, &k) in tags {
+                    index_of_tag.insert(tag, out.nodes.len() + k);
                 }
+            } else {
+                dense_min = Some(nodes.min_node_tag);
             }
-            ElementType::Qua4 | ElementType::Lin2 | ElementType::Pnt => {
-                for el in &block.elements {
-                    let ns = el
-                        .nodes
-                        .iter()
-                        .map(|&t| node_index(t))
-                        .collect::<Result<Vec<usize>>>()?;
-                    for g in &groups {
-                        out.node_sets.entry(g.clone()).or_default().extend(&ns);
-                        if ty == ElementType::Qua4 {
-                            let entry = out
-                                .face_sets
-                                .entry(g.clone())
-                                .or_insert_with(|| (Vec::new(), where_.clone()));
-                            entry.0.push(FileFace::Nodes([ns[0], ns[1], ns[2], ns[3]]));
-                        }
-                    }
-                }
-            }
-            other => {
-                return Err(Error::Input(format!(
-                    "{where_}: element type {} ({other:?}, entity of dimension {dim}, tag {}) is \
-                     not supported: tribo meshes are 8-node hexahedra (Gmsh type 5); quadrangles, \
-                     lines and points may only carry physical groups (recombine and mesh \
-                     transfinite, first order)",
-                    other as i32, block.entity_tag
-                )))
+            out.nodes
+                .extend(block.nodes.iter().map(|n| Vec3::new(n.x, n.y, n.z)));
+        }
+    }
+    NodeTags {
+        index_of_tag,
+        dense_min,
+        count: out.nodes.len(),
+    }
+}
+
+/// Adds one element block (at `where_` for messages, in physical groups `groups`) to
+/// `out`: hexahedra ([`add_hexahedra`]); quadrangles, lines and points to the groups' sets
+/// ([`add_group_elements`]). Any other element type is refused.
+fn add_element_block(
+    block: &mshio::ElementBlock<u64, i32>,
+    where_: &str,
+    groups: &[String],
+    nodes: &NodeTags,
+    file: &str,
+    out: &mut Imported,
+) -> Result<()> {
+    let dim = block.entity_dim;
+    match block.element_type {
+        ElementType::Hex8 => add_hexahedra(block, where_, groups, nodes, file, out),
+        ElementType::Qua4 | ElementType::Lin2 | ElementType::Pnt => {
+            add_group_elements(block, where_, groups, nodes, file, out)
+        }
+        other => Err(Error::Input(format!(
+            "{where_}: element type {} ({other:?}, entity of dimension {dim}, tag {}) is \
+             not supported: tribo meshes are 8-node hexahedra (Gmsh type 5); quadrangles, \
+             lines and points may only carry physical groups (recombine and mesh \
+             transfinite, first order)",
+            other as i32, block.entity_tag
+        ))),
+    }
+}
+
+/// The hexahedra of a block: each appended to `out.hexes` (with its origin for messages),
+/// and to the element set and node set of each of the block's groups.
+fn add_hexahedra(
+    block: &mshio::ElementBlock<u64, i32>,
+    where_: &str,
+    groups: &[String],
+    nodes: &NodeTags,
+    file: &str,
+    out: &mut Imported,
+) -> Result<()> {
+    for el in &block.elements {
+        let mut hex = [0usize; 8];
+        for (k, &tag) in el.nodes.iter().take(8).enumerate() {
+            hex[k] = nodes.index(tag, file)?;
+        }
+        let e = out.hexes.len();
+        out.hexes.push(hex);
+        out.hex_origin
+            .push(format!("{where_}: hexahedron {}", el.element_tag));
+        for g in groups {
+            out.element_sets.entry(g.clone()).or_default().push(e);
+            out.node_sets.entry(g.clone()).or_default().extend(hex);
+        }
+    }
+    Ok(())
+}
+
+/// The quadrangles, lines or points of a block, which only carry physical groups: their
+/// nodes join each group's node set, and a quadrangle also each group's face set (matched
+/// to a hexahedron face when the mesh is built).
+fn add_group_elements(
+    block: &mshio::ElementBlock<u64, i32>,
+    where_: &str,
+    groups: &[String],
+    nodes: &NodeTags,
+    file: &str,
+    out: &mut Imported,
+) -> Result<()> {
+    let ty = block.element_type;
+    for el in &block.elements {
+        let ns = el
+            .nodes
+            .iter()
+            .map(|&t| nodes.index(t, file))
+            .collect::<Result<Vec<usize>>>()?;
+        for g in groups {
+            out.node_sets.entry(g.clone()).or_default().extend(&ns);
+            if ty == ElementType::Qua4 {
+                let entry = out
+                    .face_sets
+                    .entry(g.clone())
+                    .or_insert_with(|| (Vec::new(), where_.to_string()));
+                entry.0.push(FileFace::Nodes([ns[0], ns[1], ns[2], ns[3]]));
             }
         }
     }
-    out.build(file)
+    Ok(())
 }
 
 /// Whether the `$MeshFormat` header says ASCII (file-type 0).

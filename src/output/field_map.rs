@@ -96,6 +96,36 @@ impl FieldMap {
     /// The map as an SVG document.
     pub fn to_svg(&self) -> Result<String> {
         self.check()?;
+        let frame = self.frame();
+        let mut out = String::new();
+        svg_open(&mut out, frame.width, frame.height);
+        text(
+            &mut out,
+            frame.width / 2.0,
+            30.0,
+            17.0,
+            "middle",
+            " font-weight=\"bold\"",
+            &self.title,
+        );
+        self.colour_fill(&mut out, &frame);
+        self.face_outlines(&mut out, &frame);
+        Self::coordinate_ticks(&mut out, &frame);
+        self.axis_titles(&mut out, &frame);
+        self.colour_bar(
+            &mut out,
+            frame.left + frame.pw + 30.0,
+            frame.bar_top,
+            frame.bar_h,
+        );
+        out.push_str("</svg>\n");
+        Ok(out)
+    }
+
+    /// The page layout: the drawn nodes' bounding box drawn at equal scales in x and y,
+    /// fitted in a 520 x 520 box, 70 px from the left; a thin strip is centred vertically
+    /// beside a colour bar of at least 150 px; room for the ticks, titles and bar around.
+    fn frame(&self) -> Frame {
         let (bx0, bx1) = data_range(self.quads.iter().flatten().map(|&n| self.points[n][0]));
         let (by0, by1) = data_range(self.quads.iter().flatten().map(|&n| self.points[n][1]));
         // Equal scales in x and y, the drawing fitted in a 520 x 520 box.
@@ -106,26 +136,34 @@ impl FieldMap {
         let top = bar_top + 0.5 * (bar_h - ph);
         let width = left + pw + 150.0;
         let height = bar_top + bar_h + 50.0;
-        let sx = |x: f64| left + (x - bx0) * scale;
-        let sy = |y: f64| top + (by1 - y) * scale;
+        Frame {
+            bx0,
+            bx1,
+            by0,
+            by1,
+            scale,
+            pw,
+            ph,
+            left,
+            top,
+            bar_top,
+            bar_h,
+            width,
+            height,
+        }
+    }
 
-        let mut out = String::new();
-        svg_open(&mut out, width, height);
-        text(
-            &mut out,
-            width / 2.0,
-            30.0,
-            17.0,
-            "middle",
-            " font-weight=\"bold\"",
-            &self.title,
-        );
+    /// The colour fill: each face cut into `n x n` sub-quads (`n` from [`MAX_SUBQUADS`],
+    /// 1 to 8), each coloured by the field interpolated bilinearly at its centre, its
+    /// corners placed by the same bilinear map (shape functions `(1-u)(1-w)`, `u(1-w)`,
+    /// `uw`, `(1-u)w`). Sub-quads are grouped by colour, one path each; a stroke of the fill
+    /// colour closes the hairline seams that anti-aliasing leaves between neighbouring
+    /// polygons.
+    fn colour_fill(&self, out: &mut String, frame: &Frame) {
         let n = ((MAX_SUBQUADS as f64 / self.quads.len() as f64)
             .sqrt()
             .floor() as usize)
             .clamp(1, 8);
-        // Sub-quads grouped by colour, one path each; a stroke of the fill colour closes
-        // the hairline seams that anti-aliasing leaves between neighbouring polygons.
         let mut by_colour: std::collections::BTreeMap<String, String> = Default::default();
         for q in &self.quads {
             let p = q.map(|k| self.points[k]);
@@ -148,8 +186,8 @@ impl FieldMap {
                             d,
                             "{}{} {}",
                             if k == 0 { "M" } else { "L" },
-                            short(sx(c.0)),
-                            short(sy(c.1))
+                            short(frame.sx(c.0)),
+                            short(frame.sy(c.1))
                         );
                     }
                     d.push('Z');
@@ -164,7 +202,10 @@ impl FieldMap {
             );
         }
         out.push_str("</g>\n");
-        // Face outlines, thin, to show the mesh: one path.
+    }
+
+    /// Face outlines, thin and translucent white, to show the mesh: one path.
+    fn face_outlines(&self, out: &mut String, frame: &Frame) {
         let mut d = String::new();
         for q in &self.quads {
             for (k, &node) in q.iter().enumerate() {
@@ -173,8 +214,8 @@ impl FieldMap {
                     d,
                     "{}{} {}",
                     if k == 0 { "M" } else { "L" },
-                    short(sx(x)),
-                    short(sy(y))
+                    short(frame.sx(x)),
+                    short(frame.sy(y))
                 );
             }
             d.push('Z');
@@ -183,24 +224,29 @@ impl FieldMap {
             out,
             "<path fill=\"none\" stroke=\"#ffffff\" stroke-opacity=\"0.25\" stroke-width=\"0.5\" d=\"{d}\"/>"
         );
-        // Coordinate ticks below and left of the drawing.
+    }
+
+    /// The drawing's border and its coordinate ticks, below (at most one per 60 px) and
+    /// left of it (one per 40 px), 1 to 6 each.
+    fn coordinate_ticks(out: &mut String, frame: &Frame) {
+        let (left, top, pw, ph) = (frame.left, frame.top, frame.pw, frame.ph);
         let _ = writeln!(
             out,
             "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#333\" stroke-width=\"0.8\"/>",
             px(left), px(top), px(pw), px(ph)
         );
-        let (xt, xs) = nice_ticks(bx0, bx1, ((pw / 60.0) as usize).clamp(1, 6));
+        let (xt, xs) = nice_ticks(frame.bx0, frame.bx1, ((pw / 60.0) as usize).clamp(1, 6));
         for t in xt {
             let _ = writeln!(
                 out,
                 "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"#333\"/>",
-                px(sx(t)),
+                px(frame.sx(t)),
                 px(top + ph),
                 px(top + ph + 5.0)
             );
             text(
-                &mut out,
-                sx(t),
+                out,
+                frame.sx(t),
                 top + ph + 19.0,
                 12.0,
                 "middle",
@@ -208,19 +254,25 @@ impl FieldMap {
                 &tick_label(t, xs),
             );
         }
-        let (yt, ys) = nice_ticks(by0, by1, ((ph / 40.0) as usize).clamp(1, 6));
+        let (yt, ys) = nice_ticks(frame.by0, frame.by1, ((ph / 40.0) as usize).clamp(1, 6));
         for t in yt {
             let _ = writeln!(
                 out,
                 "<line x1=\"{0}\" y1=\"{1}\" x2=\"{2}\" y2=\"{1}\" stroke=\"#333\"/>",
                 px(left - 5.0),
-                px(sy(t)),
+                px(frame.sy(t)),
                 px(left)
             );
-            y_tick_label(&mut out, left, sy(t), &tick_label(t, ys));
+            y_tick_label(out, left, frame.sy(t), &tick_label(t, ys));
         }
+    }
+
+    /// The axis titles below and (rotated) left of the drawing: the map's own, or "x" and
+    /// "y".
+    fn axis_titles(&self, out: &mut String, frame: &Frame) {
+        let (left, top, pw, ph) = (frame.left, frame.top, frame.pw, frame.ph);
         text(
-            &mut out,
+            out,
             left + pw / 2.0,
             top + ph + 38.0,
             13.0,
@@ -233,7 +285,7 @@ impl FieldMap {
             },
         );
         text(
-            &mut out,
+            out,
             left - 45.0,
             top + ph / 2.0,
             13.0,
@@ -249,9 +301,6 @@ impl FieldMap {
                 &self.y_label
             },
         );
-        self.colour_bar(&mut out, left + pw + 30.0, bar_top, bar_h);
-        out.push_str("</svg>\n");
-        Ok(out)
     }
 
     /// Vertical colour bar at (x, top), `h` high, low values at the bottom, with ticks.
@@ -334,6 +383,37 @@ impl FieldMap {
     /// Writes `path` (the SVG) and the CSV beside it; returns the CSV's path.
     pub fn write(&self, path: &Path) -> Result<PathBuf> {
         write_pair(path, &self.to_svg()?, &self.to_csv())
+    }
+}
+
+/// Where [`FieldMap::to_svg`] draws: the drawn nodes' bounding box `bx0..bx1 x by0..by1`,
+/// the scale (px per unit, equal in x and y), the drawing's size `pw x ph` and top-left
+/// corner `(left, top)`, the colour bar's top and height, and the page's size.
+struct Frame {
+    bx0: f64,
+    bx1: f64,
+    by0: f64,
+    by1: f64,
+    scale: f64,
+    pw: f64,
+    ph: f64,
+    left: f64,
+    top: f64,
+    bar_top: f64,
+    bar_h: f64,
+    width: f64,
+    height: f64,
+}
+
+impl Frame {
+    /// The page x of model x (x to the right).
+    fn sx(&self, x: f64) -> f64 {
+        self.left + (x - self.bx0) * self.scale
+    }
+
+    /// The page y of model y (y up, the page's y down).
+    fn sy(&self, y: f64) -> f64 {
+        self.top + (self.by1 - y) * self.scale
     }
 }
 

@@ -23,6 +23,7 @@ use crate::contact::{
 use crate::element::{in_element, LocalSolve};
 use crate::geometry::{Mat3, Projection, Vec3};
 use crate::material::PointState;
+use crate::solver::assembly::slots::AssemblySlots;
 use crate::solver::model::Model;
 use crate::solver::sparse::{SparseMatrix, SparsePattern};
 use crate::tool::pose::Pose;
@@ -642,19 +643,83 @@ impl IncrementContext<'_> {
                 .then(|| jac.values.clone());
         let slots = self.dofs.slots(model, &self.pattern);
 
+        let f_ext = self.loads(x, &mut jac, with_jacobian);
+        for d in 0..3 * self.dofs.n_nodes {
+            residual[d] = f_int[d] - f_ext[d];
+        }
+
+        let t1 = Instant::now();
+        // Multiplier components whose equation is replaced by lambda_k = 0 (see
+        // `contact_pairs`).
+        let mut unit_rows: Vec<(usize, f64)> = Vec::new();
+        let nodal = self.contact_pairs(
+            x,
+            &slots,
+            &mut jac,
+            &mut residual,
+            &mut unit_rows,
+            with_jacobian,
+            projected_at_x,
+        );
+        force_control::add_force_rows(
+            model,
+            self.dofs,
+            self.time,
+            x,
+            &nodal,
+            &slots.force_control,
+            Some(&mut residual),
+            with_jacobian.then_some(&mut jac.values[..]),
+        )?;
+        times.contact += t1.elapsed().as_secs_f64();
+
+        let support_forces =
+            self.prescribed_rows(&mut residual, &mut jac, &unit_rows, with_jacobian);
+        Ok(Evaluation {
+            residual,
+            jacobian: jac,
+            trial_points,
+            nodal,
+            f_int,
+            f_ext,
+            support_forces,
+            element_jacobian,
+            approximate_elements,
+        })
+    }
+
+    /// The external forces at `x`: the scheduled nodal loads, plus the follower loads
+    /// (pressures that turn with the surface), whose stiffness `-dF_ext/du` goes into `jac`
+    /// when `with_jacobian`.
+    fn loads(&self, x: &[f64], jac: &mut SparseMatrix, with_jacobian: bool) -> Vec<f64> {
+        let model = self.model;
         let mut f_ext = model.external_forces(self.time);
         for load in &model.follower_loads {
             let mut add = |r: usize, c: usize, v: f64| jac.add(r, c, -v);
             let stiffness = with_jacobian.then_some(&mut add as &mut dyn FnMut(usize, usize, f64));
             load.add_forces(&model.mesh, x, self.time, &mut f_ext, stiffness);
         }
-        for d in 0..3 * self.dofs.n_nodes {
-            residual[d] = f_int[d] - f_ext[d];
-        }
+        f_ext
+    }
 
-        let t1 = Instant::now();
-        // Multiplier components whose equation is replaced by lambda_k = 0 (see below).
-        let mut unit_rows: Vec<(usize, f64)> = Vec::new();
+    /// Every contact pair at `x`, tool by tool (each at its pose shifted by its force-control
+    /// offset), candidate by candidate: the operator's output added to the node's
+    /// equilibrium rows (`F_equi`), written to the pair's multiplier rows (`F_suppl`) and,
+    /// when `with_jacobian`, its blocks to `jac`; the multiplier components whose equation
+    /// becomes `lambda_k = 0` pushed to `unit_rows` with their current value. Returns the
+    /// operator output and projection of every pair (`Evaluation::nodal`).
+    #[allow(clippy::too_many_arguments)]
+    fn contact_pairs(
+        &self,
+        x: &[f64],
+        slots: &AssemblySlots,
+        jac: &mut SparseMatrix,
+        residual: &mut [f64],
+        unit_rows: &mut Vec<(usize, f64)>,
+        with_jacobian: bool,
+        projected_at_x: Option<&Evaluation>,
+    ) -> Vec<Vec<(NodalContact, Option<Projection>)>> {
+        let model = self.model;
         let mut nodal = Vec::with_capacity(model.contacts.len());
         for (c, contact) in model.contacts.iter().enumerate() {
             let pose = &force_control::shifted(&self.poses[c], model, self.dofs, c, x);
@@ -665,56 +730,13 @@ impl IncrementContext<'_> {
                 let xn = model.mesh.nodes[node]
                     + Vec3::new(x[3 * node], x[3 * node + 1], x[3 * node + 2]);
                 let x_ref = pose.to_global_point(&committed.x_ref_local);
-                let proj = match &self.frozen {
-                    Some(frames) => frames[c][k].map(|f| {
-                        let foot = pose.to_global_point(&f.foot_local);
-                        let normal = pose.to_global_vector(&f.normal_local);
-                        Projection {
-                            foot,
-                            normal,
-                            gap: normal.dot(&(xn - foot)),
-                            normal_gradient: Mat3::zeros(),
-                            hint: committed.hint.unwrap_or_default(),
-                        }
-                    }),
-                    None => match projected_at_x {
-                        Some(known) => known.nodal[c][k].1,
-                        None => contact.tool.project(pose, &xn, committed.hint.as_ref()),
-                    },
-                };
+                let proj = self.pair_projection(c, k, pose, &xn, projected_at_x);
                 let lam_dof = self.dofs.lambda_offset[c].map(|off| off + 3 * k);
                 let lambda = match lam_dof {
                     Some(l) => Vec3::new(x[l], x[l + 1], x[l + 2]),
                     None => Vec3::zeros(),
                 };
-                let mut params = OperatorParams::fixed_mu(
-                    contact.r[k],
-                    committed.mu,
-                    model.settings.contact.curvature,
-                );
-                params.forced = self.forced.as_ref().and_then(|f| f[c][k]);
-                if let (FrictionUpdate::Implicit, Some(law), Some(p), Some(_)) = (
-                    model.settings.contact.friction_update,
-                    contact.tool.friction.bernstein(),
-                    proj.as_ref(),
-                    lam_dof,
-                ) {
-                    implicit_mu(
-                        &mut params,
-                        law,
-                        committed,
-                        contact.areas[k],
-                        &xn,
-                        &x_ref,
-                        &lambda,
-                        p,
-                    );
-                }
-                let result = match (proj.as_ref(), lam_dof) {
-                    (Some(p), Some(_)) => alart_curnier(&xn, &x_ref, &lambda, p, &params),
-                    (Some(p), None) => penalty(&xn, &x_ref, committed, p, &params),
-                    (None, _) => far_from_tool(&lambda, params.r),
-                };
+                let result = self.pair_operator(c, k, &xn, &x_ref, &lambda, proj.as_ref(), lam_dof);
                 for i in 0..3 {
                     residual[3 * node + i] += result.f_equi[i];
                 }
@@ -733,24 +755,108 @@ impl IncrementContext<'_> {
                 }
                 if with_jacobian {
                     let fc_column = slots.force_control[c].as_ref().map(|f| &f.column[k]);
-                    self.add_pair_jacobian(&mut jac, pair_slots, fc_column, &result, c, lam_dof);
+                    self.add_pair_jacobian(jac, pair_slots, fc_column, &result, c, lam_dof);
                 }
                 list.push((result, proj));
             }
             nodal.push(list);
         }
-        force_control::add_force_rows(
-            model,
-            self.dofs,
-            self.time,
-            x,
-            &nodal,
-            &slots.force_control,
-            Some(&mut residual),
-            with_jacobian.then_some(&mut jac.values[..]),
-        )?;
-        times.contact += t1.elapsed().as_secs_f64();
+        nodal
+    }
 
+    /// The projection of candidate `k` of tool `c` (at `xn`, the tool at `pose`): under
+    /// frozen frames, the frozen foot and normal carried by the pose, with the gap measured
+    /// along that normal and no curvature; in a re-linearisation, the projection
+    /// `projected_at_x` already made at the same unknowns; otherwise the tool's own,
+    /// started from the committed hint. `None` where no projection exists.
+    fn pair_projection(
+        &self,
+        c: usize,
+        k: usize,
+        pose: &Pose,
+        xn: &Vec3,
+        projected_at_x: Option<&Evaluation>,
+    ) -> Option<Projection> {
+        let contact = &self.model.contacts[c];
+        let committed = &self.committed_contact[c][k];
+        match &self.frozen {
+            Some(frames) => frames[c][k].map(|f| {
+                let foot = pose.to_global_point(&f.foot_local);
+                let normal = pose.to_global_vector(&f.normal_local);
+                Projection {
+                    foot,
+                    normal,
+                    gap: normal.dot(&(xn - foot)),
+                    normal_gradient: Mat3::zeros(),
+                    hint: committed.hint.unwrap_or_default(),
+                }
+            }),
+            None => match projected_at_x {
+                Some(known) => known.nodal[c][k].1,
+                None => contact.tool.project(pose, xn, committed.hint.as_ref()),
+            },
+        }
+    }
+
+    /// The contact operator of candidate `k` of tool `c` at node position `xn`, reference
+    /// point `x_ref` and multipliers `lambda` (at `lam_dof`; `None` under penalty): its
+    /// parameters (augmentation, the committed friction coefficient or, with implicit
+    /// friction update and a Bernstein law, the one at the trial state, a status the
+    /// anti-cycling treatment imposes), then Alart-Curnier's operator, the penalty one, or
+    /// without a projection the one that drives the multipliers to zero.
+    #[allow(clippy::too_many_arguments)]
+    fn pair_operator(
+        &self,
+        c: usize,
+        k: usize,
+        xn: &Vec3,
+        x_ref: &Vec3,
+        lambda: &Vec3,
+        proj: Option<&Projection>,
+        lam_dof: Option<usize>,
+    ) -> NodalContact {
+        let model = self.model;
+        let contact = &model.contacts[c];
+        let committed = &self.committed_contact[c][k];
+        let mut params =
+            OperatorParams::fixed_mu(contact.r[k], committed.mu, model.settings.contact.curvature);
+        params.forced = self.forced.as_ref().and_then(|f| f[c][k]);
+        if let (FrictionUpdate::Implicit, Some(law), Some(p), Some(_)) = (
+            model.settings.contact.friction_update,
+            contact.tool.friction.bernstein(),
+            proj,
+            lam_dof,
+        ) {
+            implicit_mu(
+                &mut params,
+                law,
+                committed,
+                contact.areas[k],
+                xn,
+                x_ref,
+                lambda,
+                p,
+            );
+        }
+        match (proj, lam_dof) {
+            (Some(p), Some(_)) => alart_curnier(xn, x_ref, lambda, p, &params),
+            (Some(p), None) => penalty(xn, x_ref, committed, p, &params),
+            (None, _) => far_from_tool(lambda, params.r),
+        }
+    }
+
+    /// The prescribed components: the support forces (the residual's value at each fixed
+    /// row, before it is cleared) returned; each fixed row and each multiplier component of
+    /// `unit_rows` made a unit row of the Jacobian (when `with_jacobian`; otherwise the
+    /// Jacobian is emptied), its residual 0 for a fixed row and the multiplier's value for a
+    /// `lambda_k = 0` row.
+    fn prescribed_rows(
+        &self,
+        residual: &mut [f64],
+        jac: &mut SparseMatrix,
+        unit_rows: &[(usize, f64)],
+        with_jacobian: bool,
+    ) -> Vec<f64> {
         let support_forces: Vec<f64> = (0..3 * self.dofs.n_nodes)
             .map(|d| if self.is_fixed[d] { residual[d] } else { 0.0 })
             .collect();
@@ -760,7 +866,7 @@ impl IncrementContext<'_> {
                 residual[d] = 0.0;
             }
         }
-        for &(d, value) in &unit_rows {
+        for &(d, value) in unit_rows {
             unit[d] = true;
             residual[d] = value;
         }
@@ -769,17 +875,7 @@ impl IncrementContext<'_> {
         } else {
             jac.values = Vec::new();
         }
-        Ok(Evaluation {
-            residual,
-            jacobian: jac,
-            trial_points,
-            nodal,
-            f_int,
-            f_ext,
-            support_forces,
-            element_jacobian,
-            approximate_elements,
-        })
+        support_forces
     }
 }
 

@@ -216,6 +216,73 @@ impl Condenser {
         full: &SparsePattern,
         is_fixed: &[bool],
     ) -> Option<Self> {
+        let (nodes, coefficient_count) = Self::eliminated_nodes(model, dofs, full, is_fixed);
+        if nodes.is_empty() {
+            return None;
+        }
+        let (gone, condensed_row, owner) = Self::local_rows_of(&nodes, full.n);
+        let (reduced_index, next) = Self::reduced_numbering(&gone);
+        let (rows, mut entries) = Self::full_rows(full, &reduced_index);
+        Self::add_condensed_entries(&nodes, &rows, &reduced_index, &mut entries);
+        Self::add_substitution_entries(
+            &nodes,
+            &rows,
+            &reduced_index,
+            &condensed_row,
+            &owner,
+            &mut entries,
+        );
+        let groups = Self::reduced_groups(model, dofs, &reduced_index, next);
+        let pattern = Arc::new(SparsePattern::from_entries(next, entries).with_groups(groups));
+        if pattern.nnz() > u32::MAX as usize || full.nnz() > u32::MAX as usize {
+            return None;
+        }
+        let last = Self::empty_reduction(&pattern);
+        let substitutes = rows
+            .iter()
+            .map(|row| row.iter().any(|&(c, _)| owner[c].is_some()))
+            .collect();
+        let mut condenser = Condenser {
+            nodes,
+            coefficient_count,
+            reduced_index,
+            pattern,
+            rows,
+            condensed_row,
+            substitutes,
+            owner,
+            slots: Vec::new(),
+            reduced_entries: Vec::new(),
+            reduced_ptr: vec![0],
+            segment_start: Vec::new(),
+            kept_rows: Vec::new(),
+            last: Mutex::new(last),
+            fallbacks: AtomicUsize::new(0),
+        };
+        condenser.list_reduced_entries();
+        condenser.record_slot_plan(full, next);
+        // The walk's kept-row segments, in its order (then one segment per node).
+        condenser.kept_rows = (0..full.n)
+            .filter(|&r| condenser.reduced_index[r].is_some() && !condenser.condensed_row[r])
+            .collect();
+        debug_assert_eq!(
+            condenser.segment_start.len(),
+            condenser.kept_rows.len() + condenser.nodes.len() + 1
+        );
+        Some(condenser)
+    }
+
+    /// The nodes whose multipliers are eliminated, with the offset of each one's
+    /// coefficient matrix, and the coefficient buffer's length (the sum of their
+    /// `width^2`): every node with at least one contact pair (a candidate of a contact
+    /// with multipliers) and no prescribed component, in node order. Under
+    /// [`SINGLE_PAIR_VARIABLE`], nodes with several pairs keep their multipliers.
+    fn eliminated_nodes(
+        model: &Model,
+        dofs: &DofMap,
+        full: &SparsePattern,
+        is_fixed: &[bool],
+    ) -> (Vec<EliminatedNode>, usize) {
         let mut pairs_at: Vec<Vec<(usize, f64)>> = vec![Vec::new(); dofs.n_nodes];
         for (c, contact) in model.contacts.iter().enumerate() {
             let Some(off) = dofs.lambda_offset[c] else {
@@ -251,12 +318,21 @@ impl Condenser {
             coefficient_count += e.width() * e.width();
             nodes.push(e);
         }
-        if nodes.is_empty() {
-            return None;
-        }
-        let mut gone = vec![false; full.n];
-        let mut condensed_row = vec![false; full.n];
-        let mut owner = vec![None; full.n];
+        (nodes, coefficient_count)
+    }
+
+    /// Per full row, `(gone, condensed_row, owner)`: whether it is an eliminated multiplier,
+    /// whether it is one of an eliminated node's local rows (its equilibrium rows, which the
+    /// condensed rows replace, and its multipliers), and for an eliminated multiplier the
+    /// node (index in `nodes`) and row of its `C` that recovers it.
+    #[allow(clippy::type_complexity)]
+    fn local_rows_of(
+        nodes: &[EliminatedNode],
+        n: usize,
+    ) -> (Vec<bool>, Vec<bool>, Vec<Option<(usize, usize)>>) {
+        let mut gone = vec![false; n];
+        let mut condensed_row = vec![false; n];
+        let mut owner = vec![None; n];
         for (index, e) in nodes.iter().enumerate() {
             for i in 0..e.width() {
                 condensed_row[e.local_row(i)] = true;
@@ -266,7 +342,13 @@ impl Condenser {
                 }
             }
         }
-        let mut reduced_index = vec![None; full.n];
+        (gone, condensed_row, owner)
+    }
+
+    /// The reduced unknowns: every full unknown that is not eliminated, numbered in full
+    /// order; `(full -> reduced, number of reduced unknowns)`.
+    fn reduced_numbering(gone: &[bool]) -> (Vec<Option<usize>>, usize) {
+        let mut reduced_index = vec![None; gone.len()];
         let mut next = 0;
         for (d, g) in gone.iter().enumerate() {
             if !g {
@@ -274,6 +356,17 @@ impl Condenser {
                 next += 1;
             }
         }
+        (reduced_index, next)
+    }
+
+    /// The row-wise view of the full pattern (for each row, its (column, value position)
+    /// in column order) and the reduced entries the full pattern carries over as they are
+    /// (both row and column kept).
+    #[allow(clippy::type_complexity)]
+    fn full_rows(
+        full: &SparsePattern,
+        reduced_index: &[Option<usize>],
+    ) -> (Vec<Vec<(usize, usize)>>, Vec<(usize, usize)>) {
         let mut rows = vec![Vec::new(); full.n];
         let mut entries = Vec::new();
         for c in 0..full.n {
@@ -285,32 +378,75 @@ impl Condenser {
                 }
             }
         }
-        // The condensed rows combine the node's local rows, and a kept row with an
-        // eliminated column (the force row of a force-controlled tool) receives the
-        // substitution of that multiplier: both take the local rows' reduced columns.
-        let local_columns = |e: &EliminatedNode| -> Vec<usize> {
-            (0..e.width())
-                .flat_map(|i| rows[e.local_row(i)].iter())
-                .filter_map(|&(col, _)| reduced_index[col])
-                .collect()
-        };
-        for e in &nodes {
-            let columns = local_columns(e);
+        (rows, entries)
+    }
+
+    /// The reduced columns of node `e`'s local rows (repeats included): the columns that a
+    /// combination of its local rows, or the substitution of one of its multipliers, fills.
+    fn local_columns(
+        e: &EliminatedNode,
+        rows: &[Vec<(usize, usize)>],
+        reduced_index: &[Option<usize>],
+    ) -> Vec<usize> {
+        (0..e.width())
+            .flat_map(|i| rows[e.local_row(i)].iter())
+            .filter_map(|&(col, _)| reduced_index[col])
+            .collect()
+    }
+
+    /// The entries of the condensed rows: `P` combines a node's local rows, so each of its
+    /// three displacement rows takes all their reduced columns.
+    fn add_condensed_entries(
+        nodes: &[EliminatedNode],
+        rows: &[Vec<(usize, usize)>],
+        reduced_index: &[Option<usize>],
+        entries: &mut Vec<(usize, usize)>,
+    ) {
+        for e in nodes {
+            let columns = Self::local_columns(e, rows, reduced_index);
             for alpha in 0..3 {
                 let ri = reduced_index[3 * e.node + alpha].expect("displacements stay");
                 entries.extend(columns.iter().map(|&ci| (ri, ci)));
             }
         }
+    }
+
+    /// The entries of the kept rows that have an eliminated column (the force row of a
+    /// force-controlled tool): the multiplier `dl = H (rhs - N du)` substituted, they take
+    /// its node's local rows' reduced columns.
+    fn add_substitution_entries(
+        nodes: &[EliminatedNode],
+        rows: &[Vec<(usize, usize)>],
+        reduced_index: &[Option<usize>],
+        condensed_row: &[bool],
+        owner: &[Option<(usize, usize)>],
+        entries: &mut Vec<(usize, usize)>,
+    ) {
         for (r, row) in rows.iter().enumerate() {
             let (Some(ri), false) = (reduced_index[r], condensed_row[r]) else {
                 continue;
             };
             for &(c, _) in row {
                 if let Some((index, _)) = owner[c] {
-                    entries.extend(local_columns(&nodes[index]).into_iter().map(|ci| (ri, ci)));
+                    entries.extend(
+                        Self::local_columns(&nodes[index], rows, reduced_index)
+                            .into_iter()
+                            .map(|ci| (ri, ci)),
+                    );
                 }
             }
         }
+    }
+
+    /// The reduced unknowns' elimination groups: each keeps its full unknown's group
+    /// ([`elimination_groups`]), so a kept multiplier is still eliminated after its node's
+    /// displacements.
+    fn reduced_groups(
+        model: &Model,
+        dofs: &DofMap,
+        reduced_index: &[Option<usize>],
+        next: usize,
+    ) -> Vec<usize> {
         let full_groups = elimination_groups(model, dofs);
         let mut groups = vec![0; next];
         for (d, ri) in reduced_index.iter().enumerate() {
@@ -318,11 +454,13 @@ impl Condenser {
                 groups[*ri] = full_groups[d];
             }
         }
-        let pattern = Arc::new(SparsePattern::from_entries(next, entries).with_groups(groups));
-        if pattern.nnz() > u32::MAX as usize || full.nnz() > u32::MAX as usize {
-            return None;
-        }
-        let last = Reduction {
+        groups
+    }
+
+    /// The kept reduction before the first call: a zero matrix of the reduced pattern and
+    /// empty buffers (an empty `jacobian` makes the first [`Self::reduce`] whole).
+    fn empty_reduction(pattern: &Arc<SparsePattern>) -> Reduction {
+        Reduction {
             jacobian: Vec::new(),
             coefficients: Vec::new(),
             fresh_coefficients: Vec::new(),
@@ -331,48 +469,37 @@ impl Condenser {
             row_changed: Vec::new(),
             node_changed: Vec::new(),
             dirty: Vec::new(),
-        };
-        let substitutes = rows
-            .iter()
-            .map(|row| row.iter().any(|&(c, _)| owner[c].is_some()))
-            .collect();
-        let mut condenser = Condenser {
-            nodes,
-            coefficient_count,
-            reduced_index,
-            pattern,
-            rows,
-            condensed_row,
-            substitutes,
-            owner,
-            slots: Vec::new(),
-            reduced_entries: Vec::new(),
-            reduced_ptr: vec![0],
-            segment_start: Vec::new(),
-            kept_rows: Vec::new(),
-            last: Mutex::new(last),
-            fallbacks: AtomicUsize::new(0),
-        };
-        for row in &condenser.rows {
-            let kept = row.iter().filter_map(|&(col, k)| {
-                condenser.reduced_index[col].map(|ci| (ci as u32, k as u32))
-            });
-            condenser.reduced_entries.extend(kept);
-            condenser.reduced_ptr.push(condenser.reduced_entries.len());
         }
-        // Record the plan: the walk only depends on the pattern, so zero values will do.
+    }
+
+    /// Fills `reduced_entries` and `reduced_ptr`: per full row, its entries whose column
+    /// is kept, as (reduced column, value position), in `rows`' order.
+    fn list_reduced_entries(&mut self) {
+        for row in &self.rows {
+            let kept = row
+                .iter()
+                .filter_map(|&(col, k)| self.reduced_index[col].map(|ci| (ci as u32, k as u32)));
+            self.reduced_entries.extend(kept);
+            self.reduced_ptr.push(self.reduced_entries.len());
+        }
+    }
+
+    /// Records the slot plan (`slots`, `segment_start`) by one walk with a [`Recorder`]: the
+    /// walk only depends on the pattern, so zero values will do (with a zero Jacobian every
+    /// pair is in gap, `M_p = I`, and every coefficient matrix exists). `next` is the number
+    /// of reduced unknowns.
+    fn record_slot_plan(&mut self, full: &SparsePattern, next: usize) {
         let zeros = vec![0.0; full.nnz()];
         let mut coefficients = Vec::new();
-        condenser
-            .coefficients(&zeros, &mut coefficients)
+        self.coefficients(&zeros, &mut coefficients)
             .expect("with a zero Jacobian every pair is in gap");
         let mut rhs = vec![0.0; next];
         let mut plan = Recorder {
-            pattern: condenser.pattern.clone(),
+            pattern: self.pattern.clone(),
             slots: Vec::new(),
             segment_start: Vec::new(),
         };
-        condenser.walk(
+        self.walk(
             &coefficients,
             &zeros,
             &vec![0.0; full.n],
@@ -380,17 +507,8 @@ impl Condenser {
             &mut plan,
         );
         plan.segment_start.push(plan.slots.len());
-        condenser.slots = plan.slots;
-        condenser.segment_start = plan.segment_start;
-        // The walk's kept-row segments, in its order (then one segment per node).
-        condenser.kept_rows = (0..full.n)
-            .filter(|&r| condenser.reduced_index[r].is_some() && !condenser.condensed_row[r])
-            .collect();
-        debug_assert_eq!(
-            condenser.segment_start.len(),
-            condenser.kept_rows.len() + condenser.nodes.len() + 1
-        );
-        Some(condenser)
+        self.slots = plan.slots;
+        self.segment_start = plan.segment_start;
     }
 
     /// Number of eliminated multiplier unknowns.

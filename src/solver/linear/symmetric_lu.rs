@@ -120,123 +120,26 @@ pub struct SymbolicSymmetricLu {
     forest: Option<Forest>,
 }
 
+/// The error of an index beyond 32 bits (`what` of a factor of `len` entries).
+fn too_large(what: &str, len: usize) -> Error {
+    Error::LinearSolver(format!(
+        "{what} beyond 32-bit indices (factor of {len} entries): matrix too large"
+    ))
+}
+
 static NEXT_ANALYSIS_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl SymbolicSymmetricLu {
     /// AMD ordering and supernodal structure of `A + A^T`. O(nnz(L)) time and memory.
     pub fn new(pattern: &Arc<SparsePattern>) -> Result<Self> {
         let n = pattern.n;
-        // Lower triangle of A + A^T, diagonal included.
-        let lower = SparsePattern::from_entries(
-            n,
-            (0..n)
-                .flat_map(|c| {
-                    pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]]
-                        .iter()
-                        .map(move |&r| (r.max(c), r.min(c)))
-                })
-                .chain((0..n).map(|i| (i, i))),
-        );
-        let sym = SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        let grouped = match &pattern.groups {
-            Some(groups) => Some(grouped_order(&lower, groups)?),
-            None => None,
-        };
-        let ordering = match &grouped {
-            Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
-            None => SymmetricOrdering::Amd,
-        };
-        let symbolic = factorize_symbolic_cholesky(sym, Side::Lower, ordering, params)
-            .map_err(|e| Error::LinearSolver(format!("symbolic analysis failed: {e:?}")))?;
-        let perm: Vec<usize> = match symbolic.perm() {
-            Some(p) => p.arrays().0.to_vec(),
-            None => (0..n).collect(),
-        };
-        // Supernodes (first column) and their below-diagonal rows. faer may still choose a
-        // simplicial structure for a tiny or very sparse matrix: then every column is a
-        // supernode of its own.
-        let mut begin = Vec::new();
-        let mut row_ptr = vec![0];
-        let mut rows = Vec::new();
-        match symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(sn) => {
-                for s in 0..sn.n_supernodes() {
-                    begin.push(sn.supernode_begin()[s]);
-                    let mut r: Vec<usize> = sn.supernode(s).pattern().to_vec();
-                    r.sort_unstable();
-                    rows.extend_from_slice(&r);
-                    row_ptr.push(rows.len());
-                }
-            }
-            SymbolicCholeskyRaw::Simplicial(sc) => {
-                for j in 0..n {
-                    begin.push(j);
-                    let mut r: Vec<usize> = sc.row_idx()[sc.col_ptr()[j]..sc.col_ptr()[j + 1]]
-                        .iter()
-                        .copied()
-                        .filter(|&i| i > j)
-                        .collect();
-                    r.sort_unstable();
-                    rows.extend_from_slice(&r);
-                    row_ptr.push(rows.len());
-                }
-            }
-        }
-        let ns = begin.len();
+        let lower = Self::lower_triangle_of_sum(pattern);
+        let (perm, mut begin, row_ptr, rows) = Self::ordered_supernodes(pattern, &lower)?;
         begin.push(n);
-        let mut col_super = vec![0; n];
-        let mut offset = Vec::with_capacity(ns + 1);
-        let mut len = 0;
-        for s in 0..ns {
-            col_super[begin[s]..begin[s + 1]].fill(s);
-            offset.push(len);
-            let (k, r) = (begin[s + 1] - begin[s], row_ptr[s + 1] - row_ptr[s]);
-            len += (k + r) * k + r * k;
-        }
-        offset.push(len);
-        let mut lists: Vec<Vec<Update>> = vec![Vec::new(); ns];
-        for d in 0..ns {
-            let rd = &rows[row_ptr[d]..row_ptr[d + 1]];
-            let mut p1 = 0;
-            while p1 < rd.len() {
-                let s = col_super[rd[p1]];
-                let mut p2 = p1;
-                while p2 < rd.len() && rd[p2] < begin[s + 1] {
-                    p2 += 1;
-                }
-                lists[s].push(Update { d, p1, p2, rel: 0 });
-                p1 = p2;
-            }
-        }
-        let too_large = |what: &str| {
-            Error::LinearSolver(format!(
-                "{what} beyond 32-bit indices (factor of {len} entries): matrix too large"
-            ))
-        };
-        let mut update_ptr = vec![0];
-        let mut updates = Vec::new();
-        let mut relative = Vec::new();
-        let mut local = vec![0u32; n];
-        for (s, list) in lists.into_iter().enumerate() {
-            let (f, l) = (begin[s], begin[s + 1]);
-            for g in f..l {
-                local[g] = (g - f) as u32;
-            }
-            for (p, &g) in rows[row_ptr[s]..row_ptr[s + 1]].iter().enumerate() {
-                local[g] = u32::try_from(l - f + p).map_err(|_| too_large("a supernode"))?;
-            }
-            for mut up in list {
-                up.rel = relative.len();
-                let rd = &rows[row_ptr[up.d]..row_ptr[up.d + 1]];
-                relative.extend(rd[up.p1..].iter().map(|&g| local[g]));
-                updates.push(up);
-            }
-            update_ptr.push(updates.len());
-        }
+        let (col_super, offset, len) = Self::panel_layout(n, &begin, &row_ptr);
+        let lists = Self::descendant_updates(&begin, &row_ptr, &rows, &col_super);
+        let (update_ptr, updates, relative) =
+            Self::update_local_rows(lists, &begin, &row_ptr, &rows, len)?;
         let mut inverse = vec![0; n];
         for (new, &old) in perm.iter().enumerate() {
             inverse[old] = new;
@@ -260,31 +163,246 @@ impl SymbolicSymmetricLu {
             id: NEXT_ANALYSIS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             forest: None,
         };
-        let parent = (0..ns)
+        analysis.forest = Forest::new(analysis.supernode_parents(&col_super));
+        analysis.flops = analysis.supernode_flops();
+        analysis.total_flops = analysis.flops.iter().sum();
+        let (gather_ptr, gather) = analysis.gather_entries(&inverse, &col_super)?;
+        analysis.gather_ptr = gather_ptr;
+        analysis.gather = gather;
+        Ok(analysis)
+    }
+
+    /// The lower triangle of the pattern of `A + A^T`, diagonal included (every diagonal
+    /// entry present, even where `A` stores none): the graph the ordering and the symbolic
+    /// Cholesky factorization are computed on, whose factor `L` and `U^T` both share.
+    fn lower_triangle_of_sum(pattern: &SparsePattern) -> SparsePattern {
+        let n = pattern.n;
+        SparsePattern::from_entries(
+            n,
+            (0..n)
+                .flat_map(|c| {
+                    pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]]
+                        .iter()
+                        .map(move |&r| (r.max(c), r.min(c)))
+                })
+                .chain((0..n).map(|i| (i, i))),
+        )
+    }
+
+    /// The fill-reducing ordering (AMD on `lower`, or AMD on the graph of the pattern's
+    /// elimination groups, [`grouped_order`]) and faer's supernodal symbolic Cholesky
+    /// factorization of the permuted `A + A^T`: `(perm, begin, row_ptr, rows)`, `perm` new
+    /// index -> original index, then the supernodes' first columns (without the closing
+    /// `n`) and their below-diagonal rows ([`Self::supernode_rows`]).
+    #[allow(clippy::type_complexity)]
+    fn ordered_supernodes(
+        pattern: &SparsePattern,
+        lower: &SparsePattern,
+    ) -> Result<(Vec<usize>, Vec<usize>, Vec<usize>, Vec<usize>)> {
+        let n = pattern.n;
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let grouped = match &pattern.groups {
+            Some(groups) => Some(grouped_order(lower, groups)?),
+            None => None,
+        };
+        let ordering = match &grouped {
+            Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
+            None => SymmetricOrdering::Amd,
+        };
+        let symbolic = factorize_symbolic_cholesky(sym, Side::Lower, ordering, params)
+            .map_err(|e| Error::LinearSolver(format!("symbolic analysis failed: {e:?}")))?;
+        let perm: Vec<usize> = match symbolic.perm() {
+            Some(p) => p.arrays().0.to_vec(),
+            None => (0..n).collect(),
+        };
+        let (begin, row_ptr, rows) = Self::supernode_rows(symbolic.raw(), n);
+        Ok((perm, begin, row_ptr, rows))
+    }
+
+    /// Supernodes (first column) and their below-diagonal rows, sorted:
+    /// `(begin, row_ptr, rows)`, supernode s's rows being `rows[row_ptr[s]..row_ptr[s + 1]]`
+    /// (`begin` without the closing `n`). faer may still choose a simplicial structure for
+    /// a tiny or very sparse matrix: then every column is a supernode of its own, its rows
+    /// those of its column of `L` below the diagonal.
+    fn supernode_rows(
+        raw: &SymbolicCholeskyRaw<usize>,
+        n: usize,
+    ) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+        let mut begin = Vec::new();
+        let mut row_ptr = vec![0];
+        let mut rows = Vec::new();
+        match raw {
+            SymbolicCholeskyRaw::Supernodal(sn) => {
+                for s in 0..sn.n_supernodes() {
+                    begin.push(sn.supernode_begin()[s]);
+                    let mut r: Vec<usize> = sn.supernode(s).pattern().to_vec();
+                    r.sort_unstable();
+                    rows.extend_from_slice(&r);
+                    row_ptr.push(rows.len());
+                }
+            }
+            SymbolicCholeskyRaw::Simplicial(sc) => {
+                for j in 0..n {
+                    begin.push(j);
+                    let mut r: Vec<usize> = sc.row_idx()[sc.col_ptr()[j]..sc.col_ptr()[j + 1]]
+                        .iter()
+                        .copied()
+                        .filter(|&i| i > j)
+                        .collect();
+                    r.sort_unstable();
+                    rows.extend_from_slice(&r);
+                    row_ptr.push(rows.len());
+                }
+            }
+        }
+        (begin, row_ptr, rows)
+    }
+
+    /// The value array's layout: `(col_super, offset, len)`, the supernode owning each
+    /// column, the offset of each supernode's panels (and the total at the end) and the
+    /// total. Supernode s of `k` columns and `r` rows below its diagonal block takes
+    /// `(k + r) k` values for its L panel (diagonal block and `L_Rs`) then `r k` for its
+    /// `U^T` panel.
+    fn panel_layout(
+        n: usize,
+        begin: &[usize],
+        row_ptr: &[usize],
+    ) -> (Vec<usize>, Vec<usize>, usize) {
+        let ns = begin.len() - 1;
+        let mut col_super = vec![0; n];
+        let mut offset = Vec::with_capacity(ns + 1);
+        let mut len = 0;
+        for s in 0..ns {
+            col_super[begin[s]..begin[s + 1]].fill(s);
+            offset.push(len);
+            let (k, r) = (begin[s + 1] - begin[s], row_ptr[s + 1] - row_ptr[s]);
+            len += (k + r) * k + r * k;
+        }
+        offset.push(len);
+        (col_super, offset, len)
+    }
+
+    /// The descendant updates of each supernode, by updated supernode, in increasing order
+    /// of descendant: supernode d's sorted rows `R_d` cut into runs that fall into one
+    /// supernode's columns; the run `p1..p2` falling into s's columns makes `d` update `s`:
+    /// s's L panel loses `L_{R_d[p1..], d} U_{d, R_d[p1..p2]}` and its U^T panel
+    /// `U^T_{R_d[p2..], d} L_{R_d[p1..p2], d}^T` (left-looking: these are the only
+    /// descendants whose factors reach s's columns). Their local rows (`rel`) are left at 0
+    /// ([`Self::update_local_rows`]).
+    fn descendant_updates(
+        begin: &[usize],
+        row_ptr: &[usize],
+        rows: &[usize],
+        col_super: &[usize],
+    ) -> Vec<Vec<Update>> {
+        let ns = begin.len() - 1;
+        let mut lists: Vec<Vec<Update>> = vec![Vec::new(); ns];
+        for d in 0..ns {
+            let rd = &rows[row_ptr[d]..row_ptr[d + 1]];
+            let mut p1 = 0;
+            while p1 < rd.len() {
+                let s = col_super[rd[p1]];
+                let mut p2 = p1;
+                while p2 < rd.len() && rd[p2] < begin[s + 1] {
+                    p2 += 1;
+                }
+                lists[s].push(Update { d, p1, p2, rel: 0 });
+                p1 = p2;
+            }
+        }
+        lists
+    }
+
+    /// Flattens the updates into `(update_ptr, updates, relative)`, computing once the local
+    /// rows the numeric step subtracts each update's products at: for supernode s, a global
+    /// row `g` is local row `g - f` in its diagonal block (columns `f..l`) or `l - f + p` if
+    /// it is s's `p`-th row below it; `relative` holds them for every descendant row from
+    /// `p1` on. Fails when a local row does not fit 32 bits.
+    fn update_local_rows(
+        lists: Vec<Vec<Update>>,
+        begin: &[usize],
+        row_ptr: &[usize],
+        rows: &[usize],
+        len: usize,
+    ) -> Result<(Vec<usize>, Vec<Update>, Vec<u32>)> {
+        let n = begin[begin.len() - 1];
+        let mut update_ptr = vec![0];
+        let mut updates = Vec::new();
+        let mut relative = Vec::new();
+        let mut local = vec![0u32; n];
+        for (s, list) in lists.into_iter().enumerate() {
+            let (f, l) = (begin[s], begin[s + 1]);
+            for g in f..l {
+                local[g] = (g - f) as u32;
+            }
+            for (p, &g) in rows[row_ptr[s]..row_ptr[s + 1]].iter().enumerate() {
+                local[g] = u32::try_from(l - f + p).map_err(|_| too_large("a supernode", len))?;
+            }
+            for mut up in list {
+                up.rel = relative.len();
+                let rd = &rows[row_ptr[up.d]..row_ptr[up.d + 1]];
+                relative.extend(rd[up.p1..].iter().map(|&g| local[g]));
+                updates.push(up);
+            }
+            update_ptr.push(updates.len());
+        }
+        Ok((update_ptr, updates, relative))
+    }
+
+    /// The supernodal elimination tree: a supernode's parent is the supernode owning its
+    /// first row below the diagonal block (none for a root).
+    fn supernode_parents(&self, col_super: &[usize]) -> Vec<Option<usize>> {
+        let ns = self.begin.len() - 1;
+        (0..ns)
             .map(|s| {
-                let (_, _, _, rows) = analysis.panels(s);
+                let (_, _, _, rows) = self.panels(s);
                 rows.first().map(|&g| col_super[g])
             })
-            .collect();
-        analysis.forest = Forest::new(parent);
-        analysis.flops = (0..ns)
+            .collect()
+    }
+
+    /// Floating-point operations of each supernode's numeric step, `k` columns and `r` rows
+    /// below: `2/3 k^3` for the LU of its diagonal block and `2 r k^2` for the two
+    /// triangular solves, plus `2 ((rd - p1) + (rd - p2)) nc kd` per descendant update (its
+    /// two products, L's over d's rows from `p1` and U^T's from `p2`, each `nc = p2 - p1`
+    /// columns of s deep `kd`, d's column count). The cost model of
+    /// [`super::subtree_split`]'s bins and of a partial refactorization's saving.
+    fn supernode_flops(&self) -> Vec<f64> {
+        let ns = self.begin.len() - 1;
+        (0..ns)
             .map(|s| {
-                let (_, k, r, _) = analysis.panels(s);
+                let (_, k, r, _) = self.panels(s);
                 let (k, r) = (k as f64, r as f64);
                 let own = 2.0 / 3.0 * k * k * k + 2.0 * r * k * k;
-                let updates = &analysis.updates[analysis.update_ptr[s]..analysis.update_ptr[s + 1]];
+                let updates = &self.updates[self.update_ptr[s]..self.update_ptr[s + 1]];
                 own + updates
                     .iter()
                     .map(|up| {
-                        let (_, kd, rd, _) = analysis.panels(up.d);
+                        let (_, kd, rd, _) = self.panels(up.d);
                         let nc = (up.p2 - up.p1) as f64;
                         let rows = ((rd - up.p1) + (rd - up.p2)) as f64;
                         2.0 * rows * nc * kd as f64
                     })
                     .sum::<f64>()
             })
-            .collect();
-        analysis.total_flops = analysis.flops.iter().sum();
+            .collect()
+    }
+
+    /// The slot in the value array of every entry of `A` (`inverse`: original index -> new
+    /// index), grouped by owning supernode (counting sort, stable): `(gather_ptr, gather)`,
+    /// so that each supernode's numeric step gathers its own entries only. Fails when an
+    /// entry lies outside the factor (an internal error) or an index does not fit 32 bits.
+    #[allow(clippy::type_complexity)]
+    fn gather_entries(
+        &self,
+        inverse: &[usize],
+        col_super: &[usize],
+    ) -> Result<(Vec<usize>, Vec<(u32, u32)>)> {
+        let (pattern, n, ns, len) = (&self.pattern, self.n, self.begin.len() - 1, self.len);
         let mut slot = Vec::with_capacity(pattern.nnz());
         let mut entry_super = Vec::with_capacity(pattern.nnz());
         for c in 0..n {
@@ -292,7 +410,7 @@ impl SymbolicSymmetricLu {
                 let (pi, pj) = (inverse[r], inverse[c]);
                 let s = col_super[pi.min(pj)];
                 entry_super.push(s);
-                slot.push(analysis.slot_of(s, pi, pj).ok_or_else(|| {
+                slot.push(self.slot_of(s, pi, pj).ok_or_else(|| {
                     Error::LinearSolver(format!(
                         "entry ({r}, {c}) outside the symbolic factor (internal error)"
                     ))
@@ -308,7 +426,7 @@ impl SymbolicSymmetricLu {
             gather_ptr[s + 1] += gather_ptr[s];
         }
         if u32::try_from(len).is_err() || u32::try_from(slot.len()).is_err() {
-            return Err(too_large("the factor's entries"));
+            return Err(too_large("the factor's entries", len));
         }
         let mut next = gather_ptr.clone();
         let mut gather = vec![(0, 0); slot.len()];
@@ -316,9 +434,7 @@ impl SymbolicSymmetricLu {
             gather[next[s]] = (i as u32, k as u32);
             next[s] += 1;
         }
-        analysis.gather_ptr = gather_ptr;
-        analysis.gather = gather;
-        Ok(analysis)
+        Ok((gather_ptr, gather))
     }
 
     /// Value index of permuted entry (i, j) in supernode s, which owns column min(i, j).
