@@ -479,9 +479,10 @@ impl RunOutput {
             "cutbacks": sim.history.iter().map(|r| r.cutbacks).sum::<usize>(),
             "last_resort_increments": sim.history.iter().filter(|r| r.last_resort.is_some()).count(),
             "cutback_reasons": sim.history.iter().flat_map(|r| {
-                r.cutback_reasons.iter().map(move |why| serde_json::json!({
+                r.cutback_reasons.iter().enumerate().map(move |(i, why)| serde_json::json!({
                     "increment": r.index,
                     "reason": why,
+                    "kind": r.cutback_kinds.get(i).map(|k| k.name()),
                 }))
             }).collect::<Vec<_>>(),
             "symbolic_analyses": sim.symbolic_analyses(),

@@ -530,6 +530,10 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
         Dynamic::from(strings(r.cutback_reasons.iter().map(String::as_str))),
     );
     m.insert(
+        "cutback_kinds".into(),
+        Dynamic::from(strings(r.cutback_kinds.iter().map(|k| k.name()))),
+    );
+    m.insert(
         "last_resort".into(),
         r.last_resort.clone().map_or(Dynamic::UNIT, Dynamic::from),
     );

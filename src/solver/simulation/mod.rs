@@ -66,6 +66,9 @@ pub struct IncrementReport {
     /// error"), one per cutback counted in `cutbacks`.
     #[serde(default)]
     pub cutback_reasons: Vec<String>,
+    /// The kind of each failure in `cutback_reasons`, in the same order.
+    #[serde(default)]
+    pub cutback_kinds: Vec<crate::error::Failure>,
     /// The last resort that got this increment through after Newton failed at the
     /// smallest part the cut-backs allow (module `stepping`); `None` for Newton's own.
     #[serde(default)]
@@ -568,6 +571,7 @@ impl Simulation {
             cycling: Vec::new(),
             warnings: Vec::new(),
             cutback_reasons: Vec::new(),
+            cutback_kinds: Vec::new(),
             last_resort: None,
             discarded_iterations: 0,
         }

@@ -152,6 +152,7 @@ impl Simulation {
         let start = self.time;
         let mut rest_tried = false;
         let mut reasons = Vec::new();
+        let mut kinds = Vec::new();
         // The attempt at the part under way, and why the attempts before it at the same
         // part failed (the last resorts; empty for a regular attempt).
         let mut attempt = Attempt::Regular;
@@ -173,6 +174,7 @@ impl Simulation {
                     resorts_on_rest = false;
                     report.cutbacks = cutbacks - recorded;
                     report.cutback_reasons = reasons[recorded..].to_vec();
+                    report.cutback_kinds = kinds[recorded..].to_vec();
                     recorded = cutbacks;
                     discarded += report.discarded_iterations;
                     self.history.push(report.clone());
@@ -185,6 +187,7 @@ impl Simulation {
                     }
                     report.cutbacks = cutbacks;
                     report.cutback_reasons = reasons;
+                    report.cutback_kinds = kinds;
                     report.discarded_iterations = discarded;
                     return Ok(report);
                 }
@@ -197,6 +200,7 @@ impl Simulation {
                         && t_new < target =>
                 {
                     reasons.push(cutback_reason(t_new, t_new - self.time, &err));
+                    kinds.push(err.failure().0);
                     cutbacks += 1;
                     rest_tried = true;
                     dt = target - self.time;
@@ -208,6 +212,7 @@ impl Simulation {
                         && 0.5 * dt >= dt_min =>
                 {
                     reasons.push(cutback_reason(t_new, t_new - self.time, &err));
+                    kinds.push(err.failure().0);
                     cutbacks += 1;
                     in_a_row += 1;
                     dt *= 0.5;
@@ -256,6 +261,7 @@ impl Simulation {
         let mut dt = self.controller.dt.max(dt_min);
         let (mut cutbacks, mut rejected) = (0, 0);
         let mut reasons = Vec::new();
+        let mut kinds = Vec::new();
         // As in `step_fixed`.
         let mut attempt = Attempt::Regular;
         let mut failures: Vec<String> = Vec::new();
@@ -279,6 +285,7 @@ impl Simulation {
                     note_last_resort(&mut report, attempt, &failures);
                     report.cutbacks = cutbacks;
                     report.cutback_reasons = std::mem::take(&mut reasons);
+                    report.cutback_kinds = std::mem::take(&mut kinds);
                     report.rejected = rejected;
                     report.measures = measures;
                     report.limit = verdict.limit;
@@ -312,6 +319,7 @@ impl Simulation {
                         && dt_used > dt_min * (1.0 + 1e-9) =>
                 {
                     reasons.push(cutback_reason(t_new, dt_used, &err));
+                    kinds.push(err.failure().0);
                     cutbacks += 1;
                     dt = (0.5 * dt_used).max(dt_min);
                     self.controller.limit = Limit::Divergence;
