@@ -43,10 +43,10 @@ const MAX_RELEASES: usize = 3;
 /// How many times the first force residual of an attempt (above the tolerance) its force
 /// residual may reach from the second iterate on, in a model with force-controlled tools
 /// that all pressed at the committed state, before the attempt counts as diverging (see
-/// `newton`).
+/// [`DivergenceGuard`]).
 const FORCE_GROWTH_LIMIT: f64 = 3.0;
 /// How much larger than the unextrapolated start's merit the extrapolated start's may be
-/// before it is dropped (see `newton`).
+/// before it is dropped (see `Newton::first_iterate`).
 const EXTRAPOLATION_GUARD: f64 = 10.0;
 
 /// One increment's Newton solve, borrowing what it reads of the model and of the committed

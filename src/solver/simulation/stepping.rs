@@ -25,6 +25,7 @@
 //! without them keeps its increments bit for bit: they start only where the run would
 //! have stopped.
 
+use crate::error::Failure;
 use crate::solver::assembly::PhaseTimes;
 use crate::solver::linear::LinearSolver;
 use crate::solver::newton::{Attempt, Trial};
@@ -54,6 +55,33 @@ fn increment_failure(last: &Error, message: String) -> Error {
         kind,
         cycling,
         message,
+    }
+}
+
+/// The attempts an increment cut back before it converged: why each failed (one line each)
+/// and the kind of each failure.
+#[derive(Default)]
+struct Cutbacks {
+    reasons: Vec<String>,
+    kinds: Vec<Failure>,
+}
+
+impl Cutbacks {
+    /// Records the attempt to `t_new`, of size `dt`, that failed with `err`.
+    fn record(&mut self, t_new: f64, dt: f64, err: &Error) {
+        self.reasons.push(cutback_reason(t_new, dt, err));
+        self.kinds.push(err.failure().0);
+    }
+
+    fn count(&self) -> usize {
+        self.reasons.len()
+    }
+
+    /// Gives `report` the cutbacks from the `from`-th on.
+    fn report_since(&self, from: usize, report: &mut IncrementReport) {
+        report.cutbacks = self.count() - from;
+        report.cutback_reasons = self.reasons[from..].to_vec();
+        report.cutback_kinds = self.kinds[from..].to_vec();
     }
 }
 
@@ -146,13 +174,12 @@ impl Simulation {
             .stepping
             .dt_min(self.model.settings.end_time);
         let mut dt = target - self.time;
-        let (mut cutbacks, mut in_a_row, mut recorded) = (0, 0, 0);
+        let (mut in_a_row, mut recorded) = (0, 0);
+        let mut cutbacks = Cutbacks::default();
         // Over the parts, as `cutbacks` (the rows in `history` have each part's own).
         let mut discarded = 0;
         let start = self.time;
         let mut rest_tried = false;
-        let mut reasons = Vec::new();
-        let mut kinds = Vec::new();
         // The attempt at the part under way, and why the attempts before it at the same
         // part failed (the last resorts; empty for a regular attempt).
         let mut attempt = Attempt::Regular;
@@ -172,10 +199,8 @@ impl Simulation {
                     attempt = Attempt::Regular;
                     failures.clear();
                     resorts_on_rest = false;
-                    report.cutbacks = cutbacks - recorded;
-                    report.cutback_reasons = reasons[recorded..].to_vec();
-                    report.cutback_kinds = kinds[recorded..].to_vec();
-                    recorded = cutbacks;
+                    cutbacks.report_since(recorded, &mut report);
+                    recorded = cutbacks.count();
                     discarded += report.discarded_iterations;
                     self.history.push(report.clone());
                     if t_new < target {
@@ -185,9 +210,7 @@ impl Simulation {
                         rest_tried = false;
                         continue;
                     }
-                    report.cutbacks = cutbacks;
-                    report.cutback_reasons = reasons;
-                    report.cutback_kinds = kinds;
+                    cutbacks.report_since(0, &mut report);
                     report.discarded_iterations = discarded;
                     return Ok(report);
                 }
@@ -199,9 +222,7 @@ impl Simulation {
                         && self.time > start
                         && t_new < target =>
                 {
-                    reasons.push(cutback_reason(t_new, t_new - self.time, &err));
-                    kinds.push(err.failure().0);
-                    cutbacks += 1;
+                    cutbacks.record(t_new, t_new - self.time, &err);
                     rest_tried = true;
                     dt = target - self.time;
                 }
@@ -211,9 +232,7 @@ impl Simulation {
                         && in_a_row < self.model.settings.max_cutbacks
                         && 0.5 * dt >= dt_min =>
                 {
-                    reasons.push(cutback_reason(t_new, t_new - self.time, &err));
-                    kinds.push(err.failure().0);
-                    cutbacks += 1;
+                    cutbacks.record(t_new, t_new - self.time, &err);
                     in_a_row += 1;
                     dt *= 0.5;
                 }
@@ -241,9 +260,10 @@ impl Simulation {
                             return Err(increment_failure(
                                 &err,
                                 format!(
-                                    "increment {} from t = {} with dt = {dt} after {cutbacks} cutbacks: {}",
+                                    "increment {} from t = {} with dt = {dt} after {} cutbacks: {}",
                                     self.increments_done + 1,
                                     self.time,
+                                    cutbacks.count(),
                                     failure_text(&failures, attempt, &err)
                                 ),
                             ))
@@ -259,9 +279,8 @@ impl Simulation {
         let end = self.model.settings.end_time;
         let dt_min = step.dt_min(end);
         let mut dt = self.controller.dt.max(dt_min);
-        let (mut cutbacks, mut rejected) = (0, 0);
-        let mut reasons = Vec::new();
-        let mut kinds = Vec::new();
+        let mut rejected = 0;
+        let mut cutbacks = Cutbacks::default();
         // As in `step_fixed`.
         let mut attempt = Attempt::Regular;
         let mut failures: Vec<String> = Vec::new();
@@ -283,9 +302,7 @@ impl Simulation {
                     }
                     let mut report = self.accept(t_new, trial);
                     note_last_resort(&mut report, attempt, &failures);
-                    report.cutbacks = cutbacks;
-                    report.cutback_reasons = std::mem::take(&mut reasons);
-                    report.cutback_kinds = std::mem::take(&mut kinds);
+                    cutbacks.report_since(0, &mut report);
                     report.rejected = rejected;
                     report.measures = measures;
                     report.limit = verdict.limit;
@@ -299,7 +316,7 @@ impl Simulation {
                         ));
                     }
                     // No growth right after a cutback.
-                    let next = if cutbacks > 0 {
+                    let next = if cutbacks.count() > 0 {
                         verdict.next_dt.min(dt_used.max(dt_min))
                     } else {
                         verdict.next_dt
@@ -318,9 +335,7 @@ impl Simulation {
                         && attempt == Attempt::Regular
                         && dt_used > dt_min * (1.0 + 1e-9) =>
                 {
-                    reasons.push(cutback_reason(t_new, dt_used, &err));
-                    kinds.push(err.failure().0);
-                    cutbacks += 1;
+                    cutbacks.record(t_new, dt_used, &err);
                     dt = (0.5 * dt_used).max(dt_min);
                     self.controller.limit = Limit::Divergence;
                 }
@@ -333,9 +348,10 @@ impl Simulation {
                         return Err(increment_failure(
                             &err,
                             format!(
-                                "increment {} from t = {} cannot be completed at the minimum step dt = {dt_used:.6e} (dt_min = {dt_min:.6e}) after {cutbacks} cutbacks: {}",
+                                "increment {} from t = {} cannot be completed at the minimum step dt = {dt_used:.6e} (dt_min = {dt_min:.6e}) after {} cutbacks: {}",
                                 self.increments_done + 1,
                                 self.time,
+                                cutbacks.count(),
                                 failure_text(&failures, attempt, &err)
                             ),
                         ))
