@@ -39,7 +39,8 @@ pub struct SimState {
     /// Increment count of the state last saved as checkpoints/final.json.
     final_saved: Option<usize>,
     /// Why the simulation's last increment failed (its kind, and whether a contact status
-    /// cycled), for summary.json at the stop.
+    /// cycled), for summary.json at the stop; cleared by an increment that converges, so a
+    /// failure a script caught is not reported at a later stop.
     failure: Option<(crate::error::Failure, bool)>,
     /// The progress bar of a running `sim.run()`: warnings are printed with the bar cleared
     /// and drawn again under them, so the bar's line is not repeated above every warning.
@@ -325,13 +326,16 @@ impl SimState {
         self.write_due_checkpoint()?;
         let sim = self.sim.as_mut().expect("started");
         match sim.step() {
-            Ok(report) => Ok(report),
+            Ok(report) => {
+                self.failure = None;
+                Ok(report)
+            }
             Err(Error::Interrupted(why)) => Err(interrupted(&why)),
             Err(err) => {
                 let mut err = err;
-                self.failure = Some(err.failure());
+                let (kind, cycling) = err.failure();
+                self.failure = Some((kind, cycling));
                 if let Some(saved) = self.record_stop("stopped", &err.to_string()) {
-                    let (kind, cycling) = err.failure();
                     err = Error::NoConvergence {
                         kind,
                         cycling,
