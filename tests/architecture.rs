@@ -36,7 +36,9 @@ use syn::{Attribute, Expr, Item, ItemUse, UseTree};
 // The rules.
 
 /// Module `module` (and everything under it without a longer rule of its own) may use only
-/// itself and the modules under the prefixes `may_use`.
+/// itself and the modules under the prefixes `may_use`. A rule for a part of a layer
+/// (`solver::newton`) lists which parts of its layer it may use; outside the layer, the
+/// layer's own rule decides (see `permits`).
 struct Rule {
     module: &'static str,
     may_use: &'static [&'static str],
@@ -94,39 +96,27 @@ const RULES: &[Rule] = &[
     // The solver's wings (src/solver/mod.rs has the table): each may use the layers under
     // the solver and the wings before it, in this order: settings, sparse, model, assembly,
     // linear, newton, simulation. solver/mod.rs (module `solver`) declares them all.
-    Rule { module: "solver::settings", may_use: UNDER_SOLVER,
+    Rule { module: "solver::settings", may_use: &[],
            reason: "settings are plain values: they use nothing of the solver" },
-    Rule { module: "solver::sparse", may_use: UNDER_SOLVER,
+    Rule { module: "solver::sparse", may_use: &[],
            reason: "sparse storage is under every other wing: it uses nothing of the solver" },
-    Rule { module: "solver::model",
-           may_use: &["solver::settings",
-                      "geometry", "cad", "contact", "tool", "mesh", "material", "element",
-                      "error", "paths", "interrupt"],
+    Rule { module: "solver::model", may_use: &["solver::settings"],
            reason: "the model is what is solved: it knows its settings and nothing of how it \
                     is solved" },
     Rule { module: "solver::assembly",
-           may_use: &["solver::settings", "solver::sparse", "solver::model",
-                      "geometry", "cad", "contact", "tool", "mesh", "material", "element",
-                      "error", "paths", "interrupt"],
+           may_use: &["solver::settings", "solver::sparse", "solver::model"],
            reason: "assembly evaluates a trial state of the model: no linear solve, no Newton, \
                     no committed state" },
     Rule { module: "solver::linear",
-           may_use: &["solver::settings", "solver::sparse", "solver::model", "solver::assembly",
-                      "geometry", "cad", "contact", "tool", "mesh", "material", "element",
-                      "error", "paths", "interrupt"],
+           may_use: &["solver::settings", "solver::sparse", "solver::model", "solver::assembly"],
            reason: "the linear solvers (and the condensation, which reads the unknowns' layout) \
                     know nothing of Newton or the simulation" },
     Rule { module: "solver::newton",
            may_use: &["solver::settings", "solver::sparse", "solver::model", "solver::assembly",
-                      "solver::linear",
-                      "geometry", "cad", "contact", "tool", "mesh", "material", "element",
-                      "error", "paths", "interrupt"],
+                      "solver::linear"],
            reason: "Newton borrows the committed state it reads (newton::Newton) and never \
                     names the simulation that owns it" },
-    Rule { module: "solver::simulation",
-           may_use: &["solver",
-                      "geometry", "cad", "contact", "tool", "mesh", "material", "element",
-                      "error", "paths", "interrupt"],
+    Rule { module: "solver::simulation", may_use: &["solver"],
            reason: "the simulation is the top of the solver: it may use every wing" },
     Rule { module: "output",
            may_use: &["geometry", "cad", "contact", "tool", "mesh", "material", "element",
@@ -156,20 +146,6 @@ const RULES: &[Rule] = &[
            reason: "bench is on top of everything" },
     Rule { module: "lib", may_use: &[""], reason: "lib.rs declares every module" },
     Rule { module: "main", may_use: &[""], reason: "main.rs is the command line over everything" },
-];
-
-/// The layers under the solver and the foundation.
-const UNDER_SOLVER: &[&str] = &[
-    "geometry",
-    "cad",
-    "contact",
-    "tool",
-    "mesh",
-    "material",
-    "element",
-    "error",
-    "paths",
-    "interrupt",
 ];
 
 /// Only these modules name the `rhai` crate (`rhai::...`, `use rhai...`).
@@ -817,6 +793,21 @@ impl std::fmt::Display for Violation {
     }
 }
 
+/// The rule that decides whether a module under `rule` may use `to`: `rule` itself, but for
+/// a rule of a part of a layer (`solver::newton`) and a `to` outside that layer, the
+/// layer's own rule.
+fn deciding(rule: &'static Rule, to: &str) -> &'static Rule {
+    match rule.module.split_once("::") {
+        Some((layer, _)) if !under(to, layer) => rule_for(layer).map_or(rule, |r| deciding(r, to)),
+        _ => rule,
+    }
+}
+
+/// Whether `rule` lets its module use `to`: itself and its `may_use`.
+fn permits(rule: &Rule, to: &str) -> bool {
+    under(to, rule.module) || rule.may_use.iter().any(|p| under(to, p))
+}
+
 fn rule_for(key: &str) -> Option<&'static Rule> {
     RULES
         .iter()
@@ -874,19 +865,24 @@ fn check(tree: &Tree, occs: &[Occ]) -> Vec<Violation> {
                 if to == &from.key {
                     continue;
                 }
-                if let Some(rule) = rule_for(&from.key) {
+                if let Some(rule) = rule_for(&from.key).map(|r| deciding(r, to)) {
                     // A wing's unit tests may build what they test against (a Newton test
                     // builds a Simulation); the layers' rules hold for test code too.
-                    if o.test && rule.module.starts_with("solver::") {
+                    if o.test && rule.module.contains("::") {
                         continue;
                     }
-                    let allowed =
-                        under(to, rule.module) || rule.may_use.iter().any(|p| under(to, p));
-                    if !allowed {
+                    if !permits(rule, to) {
+                        let only = match (rule.module.split_once("::"), rule.may_use) {
+                            (Some((layer, _)), []) => format!("nothing else of {layer}"),
+                            (Some((layer, _)), parts) => {
+                                format!("only {} of {layer}", parts.join(", "))
+                            }
+                            (None, layers) => format!("only {}", layers.join(", ")),
+                        };
                         violation(
                             &o.written,
                             format!("`{to}`"),
-                            format!("`{}` may use only {}", rule.module, rule.may_use.join(", ")),
+                            format!("`{}` may use {only}", rule.module),
                             rule.reason,
                         );
                     }
