@@ -160,14 +160,81 @@ fn charge_output(root: &Path, next: &Path) -> Result<()> {
 
 /// Opens (creating or truncating) a file checked by [`resolve_write`], refusing a link that
 /// appeared in its place since (`O_NOFOLLOW`).
+///
+/// A file that has other hard links (`st_nlink > 1`) may be a name for a file outside the
+/// output folder, which truncating would overwrite: its name is unlinked instead and a new
+/// file created in its place (`O_EXCL`), so the other names keep their content.
 pub fn create_file(path: &Path) -> std::io::Result<std::fs::File> {
+    use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
+    let open = |exclusive: bool| {
+        let mut options = std::fs::OpenOptions::new();
+        options.write(true).custom_flags(libc::O_NOFOLLOW);
+        if exclusive {
+            options.create_new(true);
+        } else {
+            options.create(true);
+        }
+        options.open(path)
+    };
+    let file = open(false)?;
+    if file.metadata()?.nlink() > 1 {
+        drop(file);
+        std::fs::remove_file(path)?;
+        return open(true);
+    }
+    file.set_len(0)?;
+    Ok(file)
+}
+
+/// Reads a file the command line names (`--restart`): any path the user may open, but only a
+/// regular file (a FIFO would block, a device never end) and at most `max_bytes`.
+pub fn read_named_file(path: &Path, max_bytes: u64, what: &str) -> Result<Vec<u8>> {
     use std::os::unix::fs::OpenOptionsExt;
-    std::fs::OpenOptions::new()
-        .write(true)
-        .create(true)
-        .truncate(true)
-        .custom_flags(libc::O_NOFOLLOW)
+    let fail = |e: &dyn std::fmt::Display| Error::Input(format!("{what} {}: {e}", path.display()));
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
         .open(path)
+        .map_err(|e| fail(&e))?;
+    let meta = file.metadata().map_err(|e| fail(&e))?;
+    if !meta.is_file() {
+        return Err(fail(
+            &"not a regular file (folders, FIFOs and devices are refused)",
+        ));
+    }
+    read_capped(file, max_bytes).map_err(|e| match e {
+        CappedRead::Io(e) => fail(&e),
+        CappedRead::TooLarge => fail(&format_args!("over the read limit of {max_bytes} bytes")),
+    })
+}
+
+/// [`read_named_file`] as UTF-8 text, a leading byte-order mark dropped (editors on Windows
+/// write one; it is not part of the text).
+pub fn read_named_text(path: &Path, max_bytes: u64, what: &str) -> Result<String> {
+    let bytes = read_named_file(path, max_bytes, what)?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| Error::Input(format!("{what} {}: not UTF-8 text", path.display())))?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
+}
+
+enum CappedRead {
+    Io(std::io::Error),
+    TooLarge,
+}
+
+/// Reads at most `max_bytes` of `file`; more is an error, not a truncation.
+fn read_capped(file: std::fs::File, max_bytes: u64) -> std::result::Result<Vec<u8>, CappedRead> {
+    let mut bytes = Vec::new();
+    file.take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(CappedRead::Io)?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(CappedRead::TooLarge);
+    }
+    Ok(bytes)
 }
 
 /// Where scripts may read: the script's folder and the `--allow-read` folders.
@@ -309,16 +376,13 @@ impl ReadPolicy {
                 "{what} \"{given}\" is not a regular file (folders, FIFOs and devices are refused)"
             )));
         }
-        let mut bytes = Vec::new();
-        file.take(self.max_bytes + 1)
-            .read_to_end(&mut bytes)
-            .map_err(|e| Error::Input(format!("{what} \"{given}\": {e}")))?;
-        if bytes.len() as u64 > self.max_bytes {
-            return Err(Error::Input(format!(
+        let bytes = read_capped(file, self.max_bytes).map_err(|e| match e {
+            CappedRead::Io(e) => Error::Input(format!("{what} \"{given}\": {e}")),
+            CappedRead::TooLarge => Error::Input(format!(
                 "{what} \"{given}\" is over the read limit of {} bytes (--max-read-mb)",
                 self.max_bytes
-            )));
-        }
+            )),
+        })?;
         Ok((path, bytes))
     }
 }

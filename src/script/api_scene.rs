@@ -71,7 +71,14 @@ fn register_friction(engine: &mut Engine, host: std::rc::Rc<super::HostOptions>)
                 return fail(crate::Error::input("mu_at theta", theta, "must be finite"));
             }
             match law {
-                FrictionLaw::Bernstein(l) => Ok(l.mu_of_theta(theta.clamp(0.0, 1.0))),
+                FrictionLaw::Bernstein(l) if !(0.0..=1.0).contains(&theta) => {
+                    fail(crate::Error::input(
+                        "mu_at theta",
+                        theta,
+                        "must be in [0, 1] (theta is the work over work_cut, saturated at 1)",
+                    ))
+                }
+                FrictionLaw::Bernstein(l) => Ok(l.mu_of_theta(theta)),
                 FrictionLaw::Coulomb { mu } => Ok(*mu),
                 _ => runtime_error("mu_at needs a Coulomb or Bernstein law"),
             }

@@ -291,7 +291,8 @@ impl SimState {
             let frame_times = match self.host.restart.as_ref() {
                 Some(path) if !self.host.restart_used.get() => {
                     self.host.restart_used.set(true);
-                    let (times, kept) = lift(load_checkpoint(path, &mut sim))?;
+                    let max_bytes = self.host.limits.max_memory;
+                    let (times, kept) = lift(load_checkpoint(path, max_bytes, &mut sim))?;
                     self.kept = kept;
                     Some(times)
                 }
@@ -613,11 +614,14 @@ fn tool_names(s: &SimState) -> Vec<String> {
 
 /// Reads a checkpoint file into `sim`; returns the times of the frames written before it
 /// and the values the script kept.
+/// The checkpoint file is read as the command line named it, but only if it is a regular
+/// file no larger than the run's memory limit (a FIFO or a device would block or never end).
 fn load_checkpoint(
     path: &std::path::Path,
+    max_bytes: u64,
     sim: &mut Simulation,
 ) -> crate::Result<(Vec<f64>, serde_json::Map<String, serde_json::Value>)> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = crate::paths::read_named_text(path, max_bytes, "--restart")?;
     let ck = Checkpoint::from_json(&text, &path.display().to_string())?;
     let times = ck.frame_times.clone();
     let kept = ck.script.clone();

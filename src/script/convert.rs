@@ -37,11 +37,19 @@ pub fn vec3(a: &Array, what: &str) -> ScriptResult<Vec3> {
     if a.len() != 3 {
         return runtime_error(format!("{what} must have 3 components, got {}", a.len()));
     }
-    Ok(Vec3::new(
+    let v = Vec3::new(
         number(&a[0], what)?,
         number(&a[1], what)?,
         number(&a[2], what)?,
-    ))
+    );
+    // A NaN point would match node 0 in every nearest-node search and move a tool nowhere.
+    if !(v.x.is_finite() && v.y.is_finite() && v.z.is_finite()) {
+        return runtime_error(format!(
+            "{what} must be finite, got [{}, {}, {}]",
+            v.x, v.y, v.z
+        ));
+    }
+    Ok(v)
 }
 
 /// A script array of strings.

@@ -154,8 +154,10 @@ fn register_checks(engine: &mut Engine) {
     engine.register_fn(
         "assert_close",
         |a: f64, b: f64, rel: f64, msg: &str| -> convert::ScriptResult<()> {
+            // A non-finite value is never close to anything (inf - 1 <= 0.1 inf would pass).
             let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
-            if (a - b).abs() <= rel * scale {
+            let finite = a.is_finite() && b.is_finite() && rel.is_finite() && rel >= 0.0;
+            if finite && (a - b).abs() <= rel * scale {
                 Ok(())
             } else {
                 Err(Box::new(EvalAltResult::ErrorRuntime(
@@ -244,7 +246,8 @@ pub fn parse_override(text: &str) -> Result<(String, Dynamic)> {
 
 /// Compiles a script file, naming the file in errors.
 pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
-    let source = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let source =
+        crate::paths::read_named_text(path, crate::paths::DEFAULT_MAX_READ_BYTES, "script")?;
     let file = path.display().to_string();
     let mut ast = engine.compile(&source).map_err(|e| {
         let p = e.position();
@@ -315,7 +318,15 @@ pub fn apply_overrides(
     if overrides.is_empty() {
         return Ok(ast);
     }
-    let source = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    for (i, (name, _)) in overrides.iter().enumerate() {
+        if overrides[..i].iter().any(|(n, _)| n == name) {
+            return Err(Error::Input(format!(
+                "--set {name} is given more than once; give each name once"
+            )));
+        }
+    }
+    let source =
+        crate::paths::read_named_text(path, crate::paths::DEFAULT_MAX_READ_BYTES, "script")?;
     let mut patched = String::new();
     let mut seen = vec![false; overrides.len()];
     for line in source.lines() {
@@ -335,10 +346,14 @@ pub fn apply_overrides(
                 let declared = code
                     .split_once('=')
                     .map_or("", |(_, d)| d.trim().trim_end_matches(';').trim());
-                patched.push_str(&format!(
-                    "let {name} = {};",
-                    literal(&as_declared(value, declared))
-                ));
+                let value = as_declared(value, declared).map_err(|kind| {
+                    Error::Input(format!(
+                        "--set {name}={}: the script declares {kind} (`{}`)",
+                        literal(value),
+                        code.trim()
+                    ))
+                })?;
+                patched.push_str(&format!("let {name} = {};", literal(&value)));
                 seen[i] = true;
                 replaced = true;
                 break;
@@ -351,10 +366,11 @@ pub fn apply_overrides(
     }
     if let Some(i) = seen.iter().position(|s| !s) {
         return Err(Error::Input(format!(
-            "--set {}: the script {} has no top-level `let {} = ...;` to override",
+            "--set {}: the script {} has no top-level `let {} = ...;` to override; it declares: {}",
             overrides[i].0,
             path.display(),
-            overrides[i].0
+            overrides[i].0,
+            declared_names(&source).join(", ")
         )));
     }
     let file = path.display().to_string();
@@ -365,13 +381,31 @@ pub fn apply_overrides(
     Ok(ast)
 }
 
+/// The names of the script's top-level `let NAME = ...;` lines (what `--set` can override).
+fn declared_names(source: &str) -> Vec<String> {
+    source
+        .lines()
+        .filter(|l| !l.starts_with(char::is_whitespace))
+        .filter_map(|l| l.strip_prefix("let "))
+        .filter_map(|l| l.split_once('=').map(|(n, _)| n.trim().to_string()))
+        .filter(|n| !n.is_empty() && n.chars().all(|c| c.is_alphanumeric() || c == '_'))
+        .collect()
+}
+
 /// An integer given for a declaration written as a float literal (`let step = 0.5;` with
-/// `--set step=1`) becomes a float, so the script's float arithmetic keeps working.
-fn as_declared(value: &Dynamic, declared: &str) -> Dynamic {
-    let float_literal = declared.parse::<f64>().is_ok() && declared.parse::<i64>().is_err();
+/// `--set step=1`) becomes a float, so the script's float arithmetic keeps working. A value
+/// of another kind than a literal declaration's (text for a number, a number for a boolean)
+/// is refused with the kind declared: the script would fail later, far from the cause.
+fn as_declared(value: &Dynamic, declared: &str) -> std::result::Result<Dynamic, &'static str> {
+    let int_literal = declared.parse::<i64>().is_ok();
+    let float_literal = declared.parse::<f64>().is_ok() && !int_literal;
+    let bool_literal = declared == "true" || declared == "false";
+    let number = value.is_int() || value.is_float();
     match value.as_int() {
-        Ok(i) if float_literal => Dynamic::from(i as f64),
-        _ => value.clone(),
+        Ok(i) if float_literal => Ok(Dynamic::from(i as f64)),
+        _ if (int_literal || float_literal) && !number => Err("a number"),
+        _ if bool_literal && !value.is_bool() => Err("true or false"),
+        _ => Ok(value.clone()),
     }
 }
 

@@ -16,7 +16,11 @@ pub struct Table {
 
 impl Table {
     pub fn read(path: &Path) -> Result<Table> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::paths::read_named_text(
+            path,
+            crate::paths::DEFAULT_MAX_READ_BYTES,
+            "sweep table",
+        )?;
         Table::parse(&text, &path.display().to_string())
     }
 

@@ -28,6 +28,17 @@ impl ForceControl {
                 "must be a finite, non-zero vector",
             ));
         }
+        // Contact only pushes: a negative force along the axis cannot be applied through it,
+        // and the tool would leave the body (the run "finishing" with a force of 0).
+        let least = force.min_value();
+        if least < 0.0 {
+            return Err(Error::input(
+                "force-control force",
+                least,
+                "must be >= 0: the tool pushes the body along the axis through contact; \
+                 to push the other way, reverse the axis",
+            ));
+        }
         Ok(ForceControl {
             axis: axis / len,
             force,
@@ -46,5 +57,19 @@ mod tests {
         assert_eq!(f.axis, Vec3::new(0.0, 0.0, -1.0));
         let err = ForceControl::new(Vec3::zeros(), ScalarSchedule::constant(1.0)).unwrap_err();
         assert!(err.to_string().contains("force-control axis"), "{err}");
+    }
+
+    #[test]
+    fn a_pulling_force_is_refused() {
+        let axis = Vec3::new(0.0, 0.0, -1.0);
+        let err = ForceControl::new(axis, ScalarSchedule::constant(-10.0)).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("force-control force = -10 must be >= 0"),
+            "{err}"
+        );
+        let ramp = ScalarSchedule::new(vec![(0.0, 5.0), (1.0, -1.0)]).unwrap();
+        assert!(ForceControl::new(axis, ramp).is_err());
+        assert!(ForceControl::new(axis, ScalarSchedule::constant(0.0)).is_ok());
     }
 }

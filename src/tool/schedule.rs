@@ -145,6 +145,14 @@ impl ScalarSchedule {
     }
 
     /// Time of the last point.
+    /// The smallest value the schedule takes (it is piecewise linear, so at one of its points).
+    pub fn min_value(&self) -> f64 {
+        self.points
+            .iter()
+            .map(|p| p.1)
+            .fold(f64::INFINITY, f64::min)
+    }
+
     pub fn end_time(&self) -> f64 {
         end_time(&self.points)
     }
