@@ -19,8 +19,9 @@
 //! some step gets one `ForceControl` whose `windows` are those steps and whose force
 //! schedule is the steps' forces mapped onto pseudo-time. Between its windows the tool is
 //! kinematic and keeps the offset it reached (solver `force_control`), so its position is
-//! continuous when control switches. A force that jumps at the start of a step is placed a
-//! millionth of the step after its start (the step's window opens after the start).
+//! continuous when control switches. A step's force that starts at the previous step's last
+//! force goes on from it; one that jumps there is placed a millionth of the step after the
+//! start (the step's window opens after its start).
 
 use super::api_scene::scalar_schedule;
 use super::api_sim::ScriptSim;
@@ -259,7 +260,11 @@ fn force_control(
         };
         for (f, value) in force {
             let mut t = start + f * length;
-            if let Some(&(last, _)) = points.last() {
+            if let Some(&(last, previous)) = points.last() {
+                if t <= last && value == previous {
+                    // The force goes on from the previous step's last value.
+                    continue;
+                }
                 if t <= last {
                     // The step's window opens after its start: a jump sits just inside.
                     t = last + 1e-6 * length;
