@@ -814,6 +814,13 @@ fn register_stepping(engine: &mut Engine, host: &Rc<HostOptions>) {
         "run",
         move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> { run(&ctx, s, &h) },
     );
+    let h = host.clone();
+    engine.register_fn(
+        "run_step",
+        move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Dynamic> {
+            run_step(&ctx, s, &h)
+        },
+    );
     engine.register_fn("rollback", |s: &mut ScriptSim| -> ScriptResult<f64> {
         rollback(s, 1)
     });
@@ -894,7 +901,18 @@ fn run(ctx: &NativeCallContext, s: &mut ScriptSim, host: &HostOptions) -> Script
 /// `sim.run_step()`: increments to the end of the current step of a process in steps
 /// (`sim.steps`), the summary written when that ends the run; returns the last increment's
 /// report (an empty map when the run had already ended).
-pub(super) fn run_step(ctx: &NativeCallContext, s: &mut ScriptSim) -> ScriptResult<Dynamic> {
+fn run_step(
+    ctx: &NativeCallContext,
+    s: &mut ScriptSim,
+    host: &HostOptions,
+) -> ScriptResult<Dynamic> {
+    if host.defer_run.get() {
+        // The REPL loading a script that steps itself: loading ends here, as at `sim.step()`.
+        return Err(Box::new(rhai::EvalAltResult::ErrorTerminated(
+            Dynamic::from(DEFERRED),
+            rhai::Position::NONE,
+        )));
+    }
     let (step, finished) = {
         let mut st = s.borrow_mut();
         let sim = st.simulation()?;

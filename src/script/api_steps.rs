@@ -30,7 +30,7 @@ use crate::geometry::Vec3;
 use crate::solver::model::steps::Step;
 use crate::solver::model::Model;
 use crate::tool::{ForceControl, ScalarSchedule, Schedule};
-use rhai::{Array, Dynamic, Engine, Map, NativeCallContext};
+use rhai::{Array, Dynamic, Engine, Map};
 
 /// What one tool does in one step.
 #[derive(Default)]
@@ -48,12 +48,6 @@ pub fn register(engine: &mut Engine) {
             let mut st = s.borrow_mut();
             let model = st.model_mut()?;
             compile(model, &list)
-        },
-    );
-    engine.register_fn(
-        "run_step",
-        |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Dynamic> {
-            super::api_sim::run_step(&ctx, s)
         },
     );
     engine.register_fn("step_name", |s: &mut ScriptSim| -> ScriptResult<Dynamic> {
