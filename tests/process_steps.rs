@@ -44,17 +44,20 @@ fn restart_inside_a_step_and_at_its_end_equals_the_whole_run() {
     let summary = json(&full.join("summary.json"));
     let steps = summary["steps"].as_array().expect("summary.json has steps");
     let names: Vec<&str> = steps.iter().map(|s| s["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["closing", "drawing", "lifting"]);
-    // Closing 4, drawing 8, lifting 2 increments, none cut back (measured).
-    let counts: Vec<u64> = steps
-        .iter()
-        .map(|s| s["increments"].as_u64().unwrap())
-        .collect();
-    assert_eq!(counts, [4, 8, 2], "{summary}");
+    assert_eq!(names, ["closing", "drawing", "unclamping", "release"]);
+    // Every step reached its end in at least its planned increments (a cutback adds one;
+    // measured: 4, 8, 5 and 7, one cutback in the unclamping, two in the release).
+    for s in steps {
+        assert!(
+            s["increments"].as_u64() >= s["planned_increments"].as_u64(),
+            "{s}"
+        );
+    }
     assert!(steps.iter().all(|s| s["completed"] == true));
     let last = summary["increments"].as_u64().unwrap();
-    // Checkpoint 6 is inside the drawing step, 4 the end of closing.
-    for at in [6, 4] {
+    // Checkpoint 6 is inside the drawing step, 4 the end of closing, 21 inside the release
+    // after its cut-back parts (checkpoints are written at the end of nominal increments).
+    for at in [6, 4, 21] {
         let out = TestDir::new(&format!("tribo-steps-restart{at}-{tag}"));
         let ck = full.join(format!("checkpoints/checkpoint_{at:04}.json"));
         run(&out, Some(&ck));
