@@ -1,8 +1,9 @@
 //! Issue 47, steps: a process in named steps (tests/scripts/clamp_draw_steps.rhai: closing
-//! with a force-controlled holder and a stationary punch, drawing, lifting with the holder
-//! switched to displacement control, unclamping, release). A run restarted from a checkpoint inside a step, or
-//! at a step's end, equals the uninterrupted run bit for bit (history.csv and the state of
-//! the last checkpoint); summary.json says what each step did; bad steps are refused with
+//! with a force-controlled holder and a stationary punch, drawing, unclamping with the
+//! holder force ramped off, release with the holder switched to displacement control and
+//! the tools retracted). A run restarted from a checkpoint inside a step, or at a step's
+//! end, equals the uninterrupted run bit for bit (history.csv and the state of the last
+//! checkpoint); summary.json says what each step did; bad steps are refused with
 //! messages naming the step and the value.
 
 mod common;
