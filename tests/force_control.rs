@@ -77,6 +77,62 @@ fn jacobian_with_offset_unknown_matches_finite_differences() {
     );
 }
 
+/// Between the windows of its force control a tool is kinematic with its offset held
+/// (`R_s = s - s_committed`, issue 47's steps): the roller pressed over t in (0, 1], then
+/// dragged at the offset it reached. The assembled Jacobian, the held row included, against
+/// central finite differences, and the offset stays put while the tool is dragged.
+#[test]
+fn held_offset_between_windows_matches_finite_differences() {
+    let mut model = force_controlled_drag(2.0, 16, 8.0, 2.0, FORCE);
+    model.settings.increments = 12;
+    model.contacts[0]
+        .tool
+        .force_control
+        .as_mut()
+        .unwrap()
+        .windows = vec![(0.0, 1.0)];
+    let mut sim = Simulation::new(model).unwrap();
+    for _ in 0..4 {
+        sim.step().unwrap();
+    }
+    let pressed = sim.tool_offset(0);
+    for _ in 0..3 {
+        sim.step().unwrap();
+    }
+    // Held exactly: the row is linear, solved to round-off in one step.
+    assert_eq!(
+        sim.tool_offset(0),
+        pressed,
+        "the offset is held after t = 1"
+    );
+    let s_dof = sim.unknowns().len() - 1;
+    let t_new = sim.time() + 0.25;
+    let x = common::first_newton_iterate(&sim, t_new);
+    let e = sim.evaluate_at(t_new, &x).unwrap();
+    let scale = e.jacobian.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // Same step and bound as `jacobian_with_offset_unknown_matches_finite_differences`.
+    let errors = common::jacobian_column_errors(&sim, t_new, &x, 1e-7);
+    let worst = errors.iter().fold(0.0f64, |m, v| m.max(*v));
+    println!(
+        "largest entry {scale:.3e}; worst difference {worst:.3e}, offset column {:.3e}",
+        errors[s_dof]
+    );
+    assert!(
+        worst < 1e-6 * scale,
+        "assembled Jacobian differs from finite differences by {worst:e}"
+    );
+    // The held row: d R_s / d s = 1 and R_s = s - s_committed.
+    let mut es = vec![0.0; x.len()];
+    es[s_dof] = 1.0;
+    let column = e.jacobian.mul_vec(&es);
+    assert!(
+        (column[s_dof] - 1.0).abs() < 1e-12,
+        "dR_s/ds = {}",
+        column[s_dof]
+    );
+    assert!((e.residual[s_dof] - (x[s_dof] - pressed)).abs() < 1e-15);
+}
+
 /// A frictionless plane punch at height `z`, facing down, pushed down by a force ramped
 /// from 0 to `force` over t in [0, 1].
 fn punch(z: f64, force: f64) -> Tool {

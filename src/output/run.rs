@@ -142,6 +142,11 @@ impl RunOutput {
         .iter()
         .map(|(s, d)| (s.to_string(), *d))
         .collect();
+        if !sim.model.steps.is_empty() {
+            // A process in steps: which step (0, 1, ... in the order of summary.json's
+            // `steps`) each increment belongs to. Single-step runs keep their columns.
+            columns.insert(1, ("step".to_string(), None));
+        }
         for c in &sim.model.contacts {
             for axis in ["x", "y", "z"] {
                 columns.push((format!("{}_force_{axis}", c.tool.name), Force));
@@ -272,6 +277,9 @@ impl RunOutput {
             r.measures.rotation,
             r.measures.slip,
         ];
+        if let Some(k) = r.step {
+            row.insert(1, k as f64);
+        }
         for f in &r.tool_forces {
             row.extend_from_slice(f);
         }
@@ -525,6 +533,9 @@ impl RunOutput {
             "step_control": format!("{:?}", settings.stepping.mode).to_lowercase(),
         });
         if let Some(map) = summary.as_object_mut() {
+            if !sim.model.steps.is_empty() {
+                map.insert("steps".into(), steps_summary(sim, &self.frame_times));
+            }
             for (key, value) in &self.extra {
                 if map.contains_key(key) {
                     return Err(crate::Error::Input(format!(
@@ -640,4 +651,33 @@ mod tests {
         assert!(!dead.exists() && alive.exists() && foreign.exists());
         let _ = std::fs::remove_dir_all(&root);
     }
+}
+
+/// summary.json's `steps`: per step of the process, its name, interval of pseudo-time and
+/// planned increments, and what the run did in it (increments, Newton iterations,
+/// cutbacks, frames, whether it was completed).
+fn steps_summary(sim: &Simulation, frame_times: &[f64]) -> serde_json::Value {
+    use crate::solver::model::steps;
+    let list = &sim.model.steps;
+    let entries = list.iter().enumerate().map(|(k, s)| {
+        let done: Vec<&IncrementReport> =
+            sim.history.iter().filter(|r| r.step == Some(k)).collect();
+        let frames: Vec<usize> = (0..frame_times.len())
+            .filter(|&i| frame_times[i] > 0.0 && steps::step_at(list, frame_times[i]) == Some(k))
+            .collect();
+        serde_json::json!({
+            "name": s.name,
+            "start_time": steps::start(list, k),
+            "end_time": s.end,
+            "planned_increments": s.increments,
+            "increments": done.len(),
+            "first_increment": done.first().map(|r| r.index),
+            "last_increment": done.last().map(|r| r.index),
+            "newton_iterations": done.iter().map(|r| r.iterations).sum::<usize>(),
+            "cutbacks": done.iter().map(|r| r.cutbacks).sum::<usize>(),
+            "frames": frames,
+            "completed": sim.time() >= s.end * (1.0 - 1e-12),
+        })
+    });
+    serde_json::Value::Array(entries.collect())
 }

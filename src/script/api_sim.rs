@@ -495,6 +495,12 @@ impl SimState {
             lift(out.record(sim))?;
             if frames_on {
                 lift(out.write_frame_if_due(sim, report.index))?;
+                // A process in steps: a frame at every step's end (the formed, the
+                // clamped and the released shapes).
+                let at_step_end = (sim.model.steps.iter()).any(|s| s.end == report.time);
+                if at_step_end && out.frame_times().last() != Some(&report.time) {
+                    lift(out.write_frame(sim))?;
+                }
             }
             let ck = self.checkpoint_every;
             if ck > 0 && (report.index % ck == 0 || sim.is_finished()) {
@@ -527,6 +533,10 @@ impl SimState {
 fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
     let mut m = Map::new();
     m.insert("index".into(), Dynamic::from(r.index as i64));
+    m.insert(
+        "step".into(),
+        r.step.map_or(Dynamic::UNIT, |k| Dynamic::from(k as i64)),
+    );
     m.insert("time".into(), Dynamic::from(r.time));
     m.insert("iterations".into(), Dynamic::from(r.iterations as i64));
     m.insert("cutbacks".into(), Dynamic::from(r.cutbacks as i64));
@@ -808,6 +818,13 @@ fn register_stepping(engine: &mut Engine, host: &Rc<HostOptions>) {
         "run",
         move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Map> { run(&ctx, s, &h) },
     );
+    let h = host.clone();
+    engine.register_fn(
+        "run_step",
+        move |ctx: NativeCallContext, s: &mut ScriptSim| -> ScriptResult<Dynamic> {
+            run_step(&ctx, s, &h)
+        },
+    );
     engine.register_fn("rollback", |s: &mut ScriptSim| -> ScriptResult<f64> {
         rollback(s, 1)
     });
@@ -883,6 +900,56 @@ fn run(ctx: &NativeCallContext, s: &mut ScriptSim, host: &HostOptions) -> Script
     st.finish()?;
     let names = tool_names(&st);
     Ok(last.map(|r| report_map(&r, &names)).unwrap_or_default())
+}
+
+/// `sim.run_step()`: increments to the end of the current step of a process in steps
+/// (`sim.steps`), the summary written when that ends the run; returns the last increment's
+/// report (an empty map when the run had already ended).
+fn run_step(
+    ctx: &NativeCallContext,
+    s: &mut ScriptSim,
+    host: &HostOptions,
+) -> ScriptResult<Dynamic> {
+    if host.defer_run.get() {
+        // The REPL loading a script that steps itself: loading ends here, as at `sim.step()`.
+        return Err(Box::new(rhai::EvalAltResult::ErrorTerminated(
+            Dynamic::from(DEFERRED),
+            rhai::Position::NONE,
+        )));
+    }
+    let (step, finished) = {
+        let mut st = s.borrow_mut();
+        let sim = st.simulation()?;
+        (sim.current_step(), sim.is_finished())
+    };
+    let Some(k) = step else {
+        return runtime_error(
+            "sim.run_step(): the simulation has no steps (give them with sim.steps([...]))",
+        );
+    };
+    let mut last = None;
+    if !finished {
+        loop {
+            let r = advance(ctx, s)?;
+            let done = r.step != Some(k) || {
+                let st = s.borrow();
+                let sim = st.sim.as_ref().expect("started");
+                sim.is_finished() || sim.current_step() != Some(k)
+            };
+            last = Some(r);
+            if done {
+                break;
+            }
+        }
+    }
+    let mut st = s.borrow_mut();
+    if st.sim.as_ref().is_some_and(|x| x.is_finished()) {
+        st.finish()?;
+    }
+    let names = tool_names(&st);
+    Ok(Dynamic::from(
+        last.map(|r| report_map(&r, &names)).unwrap_or_default(),
+    ))
 }
 
 /// The bar of `sim.run()`: progress in pseudo-time (per mille), since the number of

@@ -13,6 +13,7 @@ mod api_round_blank;
 mod api_scene;
 mod api_shell;
 mod api_sim;
+mod api_steps;
 mod api_tools;
 mod convert;
 pub mod limits;
@@ -118,6 +119,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     api_round_blank::register(&mut engine, host.limits.clone());
     api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
+    api_steps::register(&mut engine);
     api_charts::register(&mut engine, host);
     api_mesh_map::register(&mut engine);
     api_shell::register(&mut engine);

@@ -2,6 +2,11 @@
 //! an unknown offset `s` along a fixed axis, chosen so that the force it applies to the body
 //! along that axis equals a scheduled value (a blankholder force). The solver side is
 //! `solver::force_control`.
+//!
+//! In a process of steps a tool may be force-controlled in some steps only: `windows`
+//! lists the intervals `(t0, t1]` of pseudo-time where the force equation holds (empty:
+//! always). Outside them the tool is kinematic again, its offset held at the value it had
+//! (`s = s_committed`), so that its position stays continuous when control switches.
 
 use super::schedule::ScalarSchedule;
 use crate::geometry::Vec3;
@@ -15,6 +20,8 @@ pub struct ForceControl {
     pub axis: Vec3,
     /// Force the tool applies to the body along `axis` (force units, > 0 pushes).
     pub force: ScalarSchedule,
+    /// Intervals `(t0, t1]` of pseudo-time where the force equation holds; empty: always.
+    pub windows: Vec<(f64, f64)>,
 }
 
 impl ForceControl {
@@ -42,7 +49,18 @@ impl ForceControl {
         Ok(ForceControl {
             axis: axis / len,
             force,
+            windows: Vec::new(),
         })
+    }
+
+    /// Whether the force equation holds for an increment ending at `t` (else the offset
+    /// is held). A relative round-off of `t` at a window's end counts as inside.
+    pub fn active_at(&self, t: f64) -> bool {
+        self.windows.is_empty()
+            || self.windows.iter().any(|&(a, b)| {
+                let tol = 1e-12 * b.abs().max(1.0);
+                t > a + tol && t <= b + tol
+            })
     }
 }
 
@@ -71,5 +89,15 @@ mod tests {
         let ramp = ScalarSchedule::new(vec![(0.0, 5.0), (1.0, -1.0)]).unwrap();
         assert!(ForceControl::new(axis, ramp).is_err());
         assert!(ForceControl::new(axis, ScalarSchedule::constant(0.0)).is_ok());
+    }
+
+    #[test]
+    fn windows_say_when_the_force_acts() {
+        let mut f = ForceControl::new(Vec3::z(), ScalarSchedule::constant(1.0)).unwrap();
+        assert!(f.active_at(0.0) && f.active_at(7.0), "no windows: always");
+        f.windows = vec![(0.0, 1.0), (3.0, 4.0)];
+        assert!(!f.active_at(0.0), "a window is open at its start");
+        assert!(f.active_at(0.5) && f.active_at(1.0) && f.active_at(4.0));
+        assert!(!f.active_at(2.0) && !f.active_at(4.5));
     }
 }

@@ -17,6 +17,7 @@ settings keys and tool names. Useful calls on a simulation `sim`:
                                   nodes) and returns the report map (`let r = sim.step();`
                                   `r.residuals`, or `print(r)` for all of it)
   sim.run()                       run to the end time
+  sim.run_step()                  run to the end of the current step (sim.steps([...]))
   sim.time                        current pseudo-time
   sim.tool_force(\"punch\")         total force on a tool [fx, fy, fz]
   sim.contact_nodes(\"punch\")      state of every candidate node of a tool

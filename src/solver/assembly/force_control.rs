@@ -31,6 +31,10 @@
 //! takes over. If no node lies ahead along the axis the solve stops with an error naming
 //! the tool.
 //!
+//! Outside the windows of its force control (a step where the tool is kinematic again,
+//! `tool::ForceControl::windows`) the row holds the offset: `R_s = s - s_committed`, so
+//! the tool follows its schedule shifted by the offset it had.
+//!
 //! The multipliers of a force-controlled tool are condensed out like the others (see
 //! `condense`): each node's multiplier equations still give `dl = rhs1 - K_a du` (the `s`
 //! terms cancel in `R1 - r R2` because `dF_suppl/ds = (dF_equi/ds) / r`), and the force row
@@ -102,15 +106,24 @@ pub fn add_node_column(
     }
 }
 
-/// Whether tool `c` is force-controlled and touches no node in `nodal`: its row is then
-/// the approach equation, not the force equation.
+/// Whether tool `c` is force-controlled at `time` and touches no node in `nodal`: its row
+/// is then the approach equation, not the force equation.
 pub fn approaching(
     model: &Model,
     c: usize,
+    time: f64,
     nodal: &[Vec<(NodalContact, Option<Projection>)>],
 ) -> bool {
-    model.contacts[c].tool.force_control.is_some()
-        && !nodal[c].iter().any(|(r, _)| r.status.is_active())
+    active(model, c, time) && !nodal[c].iter().any(|(r, _)| r.status.is_active())
+}
+
+/// Whether tool `c` is force-controlled at `time` (not held between its windows).
+pub fn active(model: &Model, c: usize, time: f64) -> bool {
+    model.contacts[c]
+        .tool
+        .force_control
+        .as_ref()
+        .is_some_and(|fc| fc.active_at(time))
 }
 
 /// Approach: the smallest travel of force-controlled tool `c` along its axis that closes
@@ -140,13 +153,15 @@ pub fn row_scale(model: &Model, c: usize) -> f64 {
 /// the tool touches nothing) at time `time`: its residual into `residual` and its Jacobian
 /// entries into the matrix values `jac`, at their precomputed positions `slots` (per tool),
 /// each only where given (a residual-only evaluation has no matrix; completing one
-/// with its Jacobian needs no residual). `nodal` is the evaluation's per-node output.
+/// with its Jacobian needs no residual). `nodal` is the evaluation's per-node output;
+/// `committed` the committed unknowns (the offset a tool between its windows holds).
 #[allow(clippy::too_many_arguments)]
 pub fn add_force_rows(
     model: &Model,
     dofs: &DofMap,
     time: f64,
     x: &[f64],
+    committed: &[f64],
     nodal: &[Vec<(NodalContact, Option<Projection>)>],
     slots: &[Option<ForceControlSlots>],
     mut residual: Option<&mut [f64]>,
@@ -161,7 +176,15 @@ pub fn add_force_rows(
         ) else {
             continue;
         };
-        if !approaching(model, c, nodal) {
+        if !fc.active_at(time) {
+            // Kinematic in this step: the offset stays where it was.
+            if let Some(residual) = residual.as_deref_mut() {
+                residual[s] = x[s] - committed.get(s).copied().unwrap_or(0.0);
+            }
+            if let Some(jac) = jac.as_deref_mut() {
+                jac[fs.diagonal] += 1.0;
+            }
+        } else if !approaching(model, c, time, nodal) {
             let r_s = row_scale(model, c);
             let mut pushed = 0.0;
             for k in 0..contact.candidates.len() {

@@ -298,6 +298,8 @@ pub struct Evaluation {
     /// Elements whose local solve stopped early ([`LocalSolve::Approximate`]): a Newton
     /// iterate may have them, a converged state may not.
     pub approximate_elements: usize,
+    /// The pseudo-time evaluated at (which tools are force-controlled then).
+    pub time: f64,
 }
 
 impl Evaluation {
@@ -317,6 +319,9 @@ pub struct IncrementContext<'a> {
     pub poses: Vec<Pose>,
     pub committed_points: &'a [PointState],
     pub committed_contact: &'a [Vec<ContactNodeState>],
+    /// The committed unknowns: the offset a force-controlled tool holds outside its
+    /// windows (`force_control::add_force_rows`); may be empty where no tool is held.
+    pub committed_x: &'a [f64],
     pub frozen: Option<Vec<Vec<Option<FrozenFrame>>>>,
     pub is_fixed: &'a [bool],
     /// Contact status imposed per (tool, candidate) by the anti-cycling treatment.
@@ -455,6 +460,7 @@ impl IncrementContext<'_> {
             self.dofs,
             self.time,
             x,
+            self.committed_x,
             &eval.nodal,
             &slots.force_control,
             None,
@@ -666,6 +672,7 @@ impl IncrementContext<'_> {
             self.dofs,
             self.time,
             x,
+            self.committed_x,
             &nodal,
             &slots.force_control,
             Some(&mut residual),
@@ -685,6 +692,7 @@ impl IncrementContext<'_> {
             support_forces,
             element_jacobian,
             approximate_elements,
+            time: self.time,
         })
     }
 
@@ -1006,6 +1014,7 @@ mod tests {
             poses: model.contacts.iter().map(|c| c.tool.pose(1.0)).collect(),
             committed_points: points,
             committed_contact: contact,
+            committed_x: &[],
             frozen: None,
             is_fixed,
             forced: None,

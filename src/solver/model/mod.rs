@@ -3,6 +3,7 @@
 
 pub mod augmentation;
 pub mod follower_load;
+pub mod steps;
 
 use crate::geometry::Vec3;
 use crate::material::Material;
@@ -62,6 +63,8 @@ pub struct Model {
     pub follower_loads: Vec<FollowerTraction>,
     pub contacts: Vec<ToolContact>,
     pub settings: SolverSettings,
+    /// The process's named steps (`steps`); empty: one step over the whole run.
+    pub steps: Vec<steps::Step>,
 }
 
 impl Model {
@@ -75,6 +78,7 @@ impl Model {
             follower_loads: Vec::new(),
             contacts: Vec::new(),
             settings: SolverSettings::default(),
+            steps: Vec::new(),
         })
     }
 

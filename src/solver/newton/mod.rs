@@ -96,6 +96,7 @@ impl<'a> Newton<'a> {
                 .collect(),
             committed_points: self.points,
             committed_contact: self.contact,
+            committed_x: self.x,
             frozen,
             is_fixed: self.is_fixed,
             forced: None,
@@ -428,7 +429,7 @@ impl Newton<'_> {
         // Merit: the full residual with the contact rows (lengths) scaled by r (forces). An
         // approach row is a travel to first touch, not an error to reduce: left out.
         let approach_rows: Vec<usize> = (0..self.model.contacts.len())
-            .filter(|&c| force_control::approaching(&self.model, c, &eval.nodal))
+            .filter(|&c| force_control::approaching(&self.model, c, eval.time, &eval.nodal))
             .filter_map(|c| self.dofs.tool_offset[c])
             .collect();
         let merit = (force * force
@@ -845,7 +846,7 @@ impl Newton<'_> {
         times: &mut PhaseTimes,
     ) -> Result<(Vec<f64>, Evaluation, usize, Option<Vec<f64>>)> {
         let approach = (0..self.model.contacts.len())
-            .any(|c| force_control::approaching(self.model, c, &eval.nodal));
+            .any(|c| force_control::approaching(self.model, c, eval.time, &eval.nodal));
         let mut contracted = None;
         let mut contraction_time = 0.0;
         let (x_new, eval_new, cuts) = self.line_search(

@@ -84,7 +84,7 @@ impl Newton<'_> {
             let Some(s) = self.dofs.tool_offset[c] else {
                 continue;
             };
-            if !force_control::approaching(&self.model, c, &eval.nodal) {
+            if !force_control::approaching(&self.model, c, eval.time, &eval.nodal) {
                 continue;
             }
             if let Some(travel) = force_control::approach_travel(&self.model, c, &eval.nodal) {

@@ -16,7 +16,7 @@ use crate::solver::assembly::force_control;
 use crate::solver::assembly::{DofMap, Evaluation, PhaseTimes};
 use crate::solver::linear::condense::Condenser;
 use crate::solver::linear::{LinearSolver, Solver};
-use crate::solver::model::Model;
+use crate::solver::model::{steps, Model};
 use crate::solver::newton::cycling::CyclingNode;
 use crate::solver::newton::{IterationRecord, Newton, Trial};
 use crate::solver::simulation::checkpoint::SavedState;
@@ -33,6 +33,9 @@ use std::sync::Arc;
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct IncrementReport {
     pub index: usize,
+    /// The step of the process this increment belongs to (`None` without steps).
+    #[serde(default)]
+    pub step: Option<usize>,
     pub time: f64,
     pub dt: f64,
     /// Number of linear solves.
@@ -150,6 +153,16 @@ impl Simulation {
                 "must be > 0",
             ));
         }
+        steps::validate(&model.steps)?;
+        if let Some(last) = model.steps.last() {
+            if last.end != model.settings.end_time {
+                return Err(Error::input(
+                    &format!("last step ('{}') end time", last.name),
+                    last.end,
+                    &format!("must equal the end time {}", model.settings.end_time),
+                ));
+            }
+        }
         force_control::check(&model)?;
         let dofs = DofMap::new(&model);
         let groups = crate::solver::linear::condense::elimination_groups(&model, &dofs);
@@ -242,8 +255,28 @@ impl Simulation {
         self.time >= self.model.settings.end_time * (1.0 - 1e-12)
     }
 
+    /// Fixed stepping's increment: `end_time / increments`, or in a process of steps the
+    /// current step's length over its increments.
     pub fn nominal_dt(&self) -> f64 {
-        self.model.settings.end_time / self.model.settings.increments as f64
+        match steps::next_step(&self.model.steps, self.time) {
+            Some(k) => steps::nominal_dt(&self.model.steps, k),
+            None => self.model.settings.end_time / self.model.settings.increments as f64,
+        }
+    }
+
+    /// The index of the step the next increment falls in (`None` without steps).
+    pub fn current_step(&self) -> Option<usize> {
+        steps::next_step(&self.model.steps, self.time)
+    }
+
+    /// Where fixed stepping's next nominal increment ends: `time + nominal_dt`, not past
+    /// the end time nor past the end of the current step.
+    pub(super) fn fixed_target(&self) -> f64 {
+        let target = (self.time + self.nominal_dt()).min(self.model.settings.end_time);
+        match steps::next_step(&self.model.steps, self.time) {
+            Some(k) => steps::land_on_end(&self.model.steps, k, target),
+            None => target,
+        }
     }
 
     /// Committed displacement of a node.
@@ -553,6 +586,7 @@ impl Simulation {
         self.increments_done += 1;
         IncrementReport {
             index: self.increments_done,
+            step: steps::step_at(&self.model.steps, t_new),
             time: t_new,
             dt,
             iterations,

@@ -296,6 +296,8 @@ pub fn schedule_stops(model: &Model) -> Vec<f64> {
     for l in &model.loads {
         stops.extend(l.scale.points().iter().map(|p| p.0));
     }
+    // A step ends where the process changes: adaptive increments land there too.
+    stops.extend(model.steps.iter().map(|s| s.end));
     stops.retain(|&t| t > 0.0 && t < end);
     stops.push(end);
     stops.sort_by(f64::total_cmp);

@@ -167,7 +167,7 @@ impl Simulation {
     /// also did, but changed the U-channel's increments enough to take one to 30
     /// iterations. Every converged part is at least `dt_min`, so an increment ends.
     fn step_fixed(&mut self) -> Result<IncrementReport> {
-        let target = (self.time + self.nominal_dt()).min(self.model.settings.end_time);
+        let target = self.fixed_target();
         let dt_min = self
             .model
             .settings
