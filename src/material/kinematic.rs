@@ -416,8 +416,9 @@ mod tests {
         t
     }
 
-    /// Largest difference between the computed uniaxial stress and the closed form of the
-    /// Armstrong-Frederick law (module docs), `σ = Σ x_i + s σ_y(p)`, over the plastic
+    /// Largest difference between the computed uniaxial stress and back stress and the
+    /// closed form of the Armstrong-Frederick law (module docs), `x = Σ x_i`,
+    /// `σ = x + s σ_y(p)`, over the plastic
     /// increments of `states`; the closed form is continued branch by branch from each
     /// reversal's plastic strain. Also returns the number of reversals seen.
     fn closed_form_error(
@@ -458,13 +459,7 @@ mod tests {
             worst = worst.max((st.stress[0] - expect).abs());
             // Uniaxial von Mises: the back stress is (2/3 x, -1/3 x, -1/3 x) of x = Xxx - Xyy.
             let xt = st.total_back_stress();
-            assert!(
-                (xt[0] - xt[1] - x.iter().sum::<f64>()).abs() <= 0.05 * expect.abs(),
-                "{} vs {x:?} at {ep}, p {}, stress {} vs {expect}",
-                xt[0] - xt[1],
-                st.eq_plastic_strain,
-                st.stress[0]
-            );
+            worst = worst.max((xt[0] - xt[1] - x.iter().sum::<f64>()).abs());
         }
         (worst, reversals)
     }
