@@ -118,7 +118,10 @@ fn bend_and_release(k: f64, points: usize) -> (f64, f64) {
     model.settings.increments = STEPS;
     model.settings.force_rel_tol = 1e-10;
     let end: Vec<usize> = model.nodes("x+").unwrap();
-    let (bottom, top) = (model.nodes("end0").unwrap()[0], model.nodes("end1").unwrap()[0]);
+    let (bottom, top) = (
+        model.nodes("end0").unwrap()[0],
+        model.nodes("end1").unwrap()[0],
+    );
     let mut sim = Simulation::new(model).unwrap();
     let (mut kappa, mut moment) = (vec![], vec![]);
     while !sim.is_finished() {
@@ -173,5 +176,9 @@ fn released_curvature_of_an_epp_strip_is_the_closed_form() {
             }
         }
     }
-    assert!(worst < 0.01, "released curvature off by {:.2} %", 100.0 * worst);
+    assert!(
+        worst < 0.01,
+        "released curvature off by {:.2} %",
+        100.0 * worst
+    );
 }

@@ -250,7 +250,10 @@ impl Chaboche {
             iso,
             self,
             sig_tr,
-            &format!("no convergence in {MAX_ITER} iterations, residual {:e}", res.amax()),
+            &format!(
+                "no convergence in {MAX_ITER} iterations, residual {:e}",
+                res.amax()
+            ),
         ))
     }
 
@@ -301,9 +304,9 @@ impl Chaboche {
         let a = self.factors(dl);
         let wn = tensor_of_strain(&n);
         let back_stress: [Voigt; BACK_STRESSES] = std::array::from_fn(|i| {
-            self.terms
-                .get(i)
-                .map_or(Voigt::zeros(), |&(c, _)| (back_n[i] + wn * (2.0 / 3.0 * c * dl)) * a[i])
+            self.terms.get(i).map_or(Voigt::zeros(), |&(c, _)| {
+                (back_n[i] + wn * (2.0 / 3.0 * c * dl)) * a[i]
+            })
         });
         let stress = sig_tr - d * n * dl;
         let mut t = Tangent::zeros();
@@ -407,7 +410,11 @@ mod tests {
         let de = amp / per_branch as f64;
         let mut t = Vec::new();
         let mut e = 0.0;
-        for (dir, count) in [(1.0, per_branch), (-1.0, 2 * per_branch), (1.0, 2 * per_branch)] {
+        for (dir, count) in [
+            (1.0, per_branch),
+            (-1.0, 2 * per_branch),
+            (1.0, 2 * per_branch),
+        ] {
             for _ in 0..count {
                 e += dir * de;
                 t.push(e);
@@ -590,7 +597,9 @@ mod tests {
         let f = Mat3::new(1.25, 0.1, -0.05, 0.03, 0.9, 0.08, -0.1, 0.05, 0.93);
         let sqrt = |c: &Mat3| {
             let e = SymmetricEigen::new(*c);
-            e.eigenvectors * Mat3::from_diagonal(&e.eigenvalues.map(f64::sqrt)) * e.eigenvectors.transpose()
+            e.eigenvectors
+                * Mat3::from_diagonal(&e.eigenvalues.map(f64::sqrt))
+                * e.eigenvectors.transpose()
         };
         for yf in [Hill48::von_mises(), anisotropic()] {
             let m = steel(
@@ -636,8 +645,12 @@ mod tests {
             let m = steel(Hardening::swift(500.0, 0.01, 0.22).unwrap(), yf, &terms);
             let eps = Voigt::new(0.3, -0.1, -0.2, 0.1, 0.05, -0.02);
             let mut st = PointState::default();
-            m.update(&Kinematics::from_strain(eps), &PointState::default(), &mut st)
-                .unwrap();
+            m.update(
+                &Kinematics::from_strain(eps),
+                &PointState::default(),
+                &mut st,
+            )
+            .unwrap();
             let sy = m.hardening().yield_stress(st.eq_plastic_strain);
             assert!(m.yield_value(&st).abs() < 1e-9 * sy);
             let dl = st.eq_plastic_strain;
@@ -659,7 +672,11 @@ mod tests {
         let json = serde_json::to_string(&iso).unwrap();
         assert!(!json.contains("back_stress"));
         assert_eq!(serde_json::from_str::<PointState>(&json).unwrap(), iso);
-        let m = steel(Hardening::linear(250.0, 0.0).unwrap(), anisotropic(), &[(1e4, 50.0)]);
+        let m = steel(
+            Hardening::linear(250.0, 0.0).unwrap(),
+            anisotropic(),
+            &[(1e4, 50.0)],
+        );
         let mut st = PointState::default();
         m.update(
             &Kinematics::from_strain(Voigt::new(0.01, -0.002, 0.0, 0.003, 0.0, 0.0)),
@@ -676,13 +693,22 @@ mod tests {
     fn bad_constants_are_errors_naming_the_value() {
         let msg = |t: &[(f64, f64)]| Chaboche::new(t).unwrap_err().to_string();
         let m = msg(&[(1e4, 10.0), (-5.0, 1.0)]);
-        assert!(m.contains("Chaboche term 2 C = -5") && m.contains("> 0"), "{m}");
+        assert!(
+            m.contains("Chaboche term 2 C = -5") && m.contains("> 0"),
+            "{m}"
+        );
         let m = msg(&[(1e4, -3.0)]);
-        assert!(m.contains("Chaboche term 1 gamma = -3") && m.contains(">= 0"), "{m}");
+        assert!(
+            m.contains("Chaboche term 1 gamma = -3") && m.contains(">= 0"),
+            "{m}"
+        );
         let m = msg(&[(1e4, f64::NAN)]);
         assert!(m.contains("gamma = NaN"), "{m}");
         let m = msg(&[(1.0, 1.0); 4]);
-        assert!(m.contains("Chaboche number of terms = 4") && m.contains("1 to 3"), "{m}");
+        assert!(
+            m.contains("Chaboche number of terms = 4") && m.contains("1 to 3"),
+            "{m}"
+        );
         assert!(msg(&[]).contains("number of terms = 0"));
         assert!(Chaboche::new(&[(1e4, 0.0)]).is_ok());
     }

@@ -98,7 +98,10 @@ pub struct PointState {
     /// (Cauchy under small strain, the log-space stress `T` under finite kinematics).
     /// All zero for materials without kinematic hardening; then not written into
     /// checkpoints (so their files are unchanged) and read back as zero.
-    #[serde(default = "no_back_stress", skip_serializing_if = "is_zero_back_stress")]
+    #[serde(
+        default = "no_back_stress",
+        skip_serializing_if = "is_zero_back_stress"
+    )]
     pub back_stress: [Voigt; BACK_STRESSES],
 }
 

@@ -556,11 +556,18 @@ mod kinematic_tests {
             "elastoplastic(210000, 0.3, von_mises(), voce(200, 100, 8), chaboche([[1000, 0]]))",
         );
         assert!(m.is_ok());
-        let err = eval("chaboche([[30000, 200], [-5, 1]])").map(|_| ()).unwrap_err();
+        let err = eval("chaboche([[30000, 200], [-5, 1]])")
+            .map(|_| ())
+            .unwrap_err();
         assert!(err.contains("Chaboche term 2 C = -5"), "{err}");
-        let err = eval("chaboche([[1, 1], [1, 1], [1, 1], [1, 1]])").map(|_| ()).unwrap_err();
+        let err = eval("chaboche([[1, 1], [1, 1], [1, 1], [1, 1]])")
+            .map(|_| ())
+            .unwrap_err();
         assert!(err.contains("number of terms = 4"), "{err}");
         let err = eval("chaboche([[1000]])").map(|_| ()).unwrap_err();
-        assert!(err.contains("chaboche term 1") && err.contains("[C, gamma]"), "{err}");
+        assert!(
+            err.contains("chaboche term 1") && err.contains("[C, gamma]"),
+            "{err}"
+        );
     }
 }
