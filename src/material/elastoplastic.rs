@@ -47,8 +47,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::kinematic::Isotropic;
 use super::spectral_return::SpectralReturn;
-use super::{Hardening, Hill48, Kinematics, LinearElastic, Material, PointState, Tangent, Voigt};
+use super::{
+    Chaboche, Hardening, Hill48, Kinematics, LinearElastic, Material, PointState, Tangent, Voigt,
+};
 use crate::{Error, Result};
 
 /// Relative yield tolerance: a trial stress within this fraction of the yield stress is
@@ -76,6 +79,9 @@ pub struct ElastoPlastic {
     /// The eigenbasis of `(P, S)` (None only if `S` were not positive definite, which
     /// [`LinearElastic`]'s admissible parameters exclude).
     spectral: Option<SpectralReturn>,
+    /// Kinematic hardening (`material::kinematic`), None for purely isotropic hardening
+    /// (whose code path is then exactly the one without this field).
+    kinematic: Option<Chaboche>,
 }
 
 /// Result of a return mapping: stress, multiplier increment and consistent tangent.
@@ -94,7 +100,22 @@ impl ElastoPlastic {
             yield_function,
             hardening,
             spectral,
+            kinematic: None,
         }
+    }
+
+    /// The same material with the kinematic hardening `law` on top of its isotropic law
+    /// (mixed hardening, `material::kinematic`).
+    pub fn with_kinematic(self, law: Chaboche) -> Self {
+        ElastoPlastic {
+            kinematic: Some(law),
+            ..self
+        }
+    }
+
+    /// The kinematic hardening law, if any.
+    pub fn kinematic(&self) -> Option<&Chaboche> {
+        self.kinematic.as_ref()
     }
 
     /// The elastic part.
@@ -114,7 +135,8 @@ impl ElastoPlastic {
 
     /// Yield function value `f = φ(σ) - σ_y(ε̄p)` of a state (`<= 0` inside the surface).
     pub fn yield_value(&self, state: &PointState) -> f64 {
-        self.yield_function.equivalent_stress(&state.stress)
+        self.yield_function
+            .equivalent_stress(&(state.stress - state.total_back_stress()))
             - self.hardening.yield_stress(state.eq_plastic_strain)
     }
 
@@ -311,6 +333,9 @@ impl ElastoPlastic {
                 ),
             ));
         }
+        if let Some(law) = &self.kinematic {
+            return self.update_kinematic(law, kin, committed, trial, tangent);
+        }
         let ebar_n = committed.eq_plastic_strain;
         let sig_tr = self
             .elastic
@@ -337,6 +362,58 @@ impl ElastoPlastic {
             eq_plastic_strain: ebar_n + ret.dlambda,
             // Trapezoidal, like the external work, so that the balance
             // W_ext = Ψe + D_p closes exactly for a small-strain body.
+            plastic_dissipation: committed.plastic_dissipation
+                + 0.5
+                    * (committed.stress + ret.stress)
+                        .dot(&(plastic_strain - committed.plastic_strain)),
+            ..base
+        };
+        Ok(ret.tangent)
+    }
+
+    /// [`update_with`](Self::update_with) under mixed hardening: the yield function of
+    /// `σ - X`, the back stresses updated by the return of `material::kinematic`.
+    fn update_kinematic(
+        &self,
+        law: &Chaboche,
+        kin: &Kinematics,
+        committed: &PointState,
+        trial: &mut PointState,
+        tangent: bool,
+    ) -> Result<Tangent> {
+        let ebar_n = committed.eq_plastic_strain;
+        let sig_tr = self
+            .elastic
+            .stress(&(kin.strain - committed.plastic_strain));
+        let base = PointState {
+            strain: kin.strain,
+            deformation_gradient: kin.deformation_gradient,
+            ..*committed
+        };
+        let sy = self.hardening.yield_stress(ebar_n);
+        let relative = sig_tr - committed.total_back_stress();
+        if self.yield_function.equivalent_stress(&relative) - sy <= YIELD_TOL * sy {
+            *trial = PointState {
+                stress: sig_tr,
+                ..base
+            };
+            return Ok(self.elastic.tangent());
+        }
+        let stiffness = self.elastic.tangent();
+        let iso = Isotropic {
+            stiffness: &stiffness,
+            yield_function: &self.yield_function,
+            hardening: &self.hardening,
+        };
+        let ret = law.return_map(&iso, &sig_tr, &committed.back_stress, ebar_n, tangent)?;
+        let plastic_strain = kin.strain - self.elastic.compliance() * ret.stress;
+        *trial = PointState {
+            stress: ret.stress,
+            plastic_strain,
+            eq_plastic_strain: ebar_n + ret.dlambda,
+            back_stress: ret.back_stress,
+            // The plastic work ∫ σ·dεp (dissipated plus stored in the back stresses),
+            // trapezoidal as in the isotropic case, so that W_ext = Ψe + W_p still closes.
             plastic_dissipation: committed.plastic_dissipation
                 + 0.5
                     * (committed.stress + ret.stress)
@@ -377,14 +454,24 @@ impl Material for ElastoPlastic {
     }
 
     /// Hill48's `φ` (von Mises for isotropic coefficients), in the material axes.
+    /// Under kinematic hardening, of the stress relative to the back stress, `φ(σ - X)`.
     fn equivalent_stress(&self, state: &PointState, finite: bool) -> f64 {
+        if self.kinematic.is_none() {
+            return self
+                .yield_function
+                .equivalent_stress(state.material_stress(finite));
+        }
         self.yield_function
-            .equivalent_stress(state.material_stress(finite))
+            .equivalent_stress(&(state.material_stress(finite) - state.total_back_stress()))
     }
 
     fn describe(&self) -> String {
+        let kinematic = self
+            .kinematic
+            .as_ref()
+            .map_or(String::new(), |k| format!(", {}", k.describe()));
         format!(
-            "elastoplastic E={} nu={}, {}, {}",
+            "elastoplastic E={} nu={}, {}, {}{kinematic}",
             self.elastic.young(),
             self.elastic.poisson(),
             self.yield_function.describe(),

@@ -34,6 +34,7 @@ use crate::Result;
 mod elastoplastic;
 mod hardening;
 mod hill48;
+mod kinematic;
 mod linear_elastic;
 pub mod log_strain;
 mod spectral_return;
@@ -42,6 +43,7 @@ mod sym_eigen3;
 pub use elastoplastic::ElastoPlastic;
 pub use hardening::Hardening;
 pub use hill48::Hill48;
+pub use kinematic::Chaboche;
 pub use linear_elastic::LinearElastic;
 
 /// A symmetric tensor in Voigt notation `[xx, yy, zz, xy, yz, zx]`; see the module
@@ -91,6 +93,28 @@ pub struct PointState {
     /// written before it existed (read as zero).
     #[serde(default)]
     pub enhanced: [f64; ENHANCED_PARAMETERS],
+    /// Back stresses `X_i` of a kinematic hardening law (`material::kinematic`: one per
+    /// Armstrong-Frederick term, unused ones zero), in the stress the material works in
+    /// (Cauchy under small strain, the log-space stress `T` under finite kinematics).
+    /// All zero for materials without kinematic hardening; then not written into
+    /// checkpoints (so their files are unchanged) and read back as zero.
+    #[serde(
+        default = "no_back_stress",
+        skip_serializing_if = "is_zero_back_stress"
+    )]
+    pub back_stress: [Voigt; BACK_STRESSES],
+}
+
+/// Largest number of back stresses a [`PointState`] carries (Armstrong-Frederick terms
+/// of a Chaboche law).
+pub const BACK_STRESSES: usize = 3;
+
+fn no_back_stress() -> [Voigt; BACK_STRESSES] {
+    [Voigt::zeros(); BACK_STRESSES]
+}
+
+fn is_zero_back_stress(x: &[Voigt; BACK_STRESSES]) -> bool {
+    x.iter().all(|v| v.iter().all(|&c| c == 0.0))
 }
 
 /// Number of element-level internal variables a [`PointState`] carries
@@ -109,6 +133,13 @@ impl PointState {
     }
 }
 
+impl PointState {
+    /// The total back stress `X = Σ X_i` (zero without kinematic hardening).
+    pub fn total_back_stress(&self) -> Voigt {
+        self.back_stress.iter().sum()
+    }
+}
+
 impl Default for PointState {
     /// The virgin state: stress- and strain-free, `F = I`.
     fn default() -> Self {
@@ -121,6 +152,7 @@ impl Default for PointState {
             log_stress: Voigt::zeros(),
             plastic_dissipation: 0.0,
             enhanced: [0.0; ENHANCED_PARAMETERS],
+            back_stress: no_back_stress(),
         }
     }
 }

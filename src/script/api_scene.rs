@@ -4,7 +4,7 @@
 use super::convert::*;
 use crate::contact::{BernsteinLaw, FrictionLaw, WorkMeasure};
 use crate::geometry::{Cylinder, Plane, RigidSurface, Sphere};
-use crate::material::{ElastoPlastic, Hardening, Hill48, LinearElastic, Material};
+use crate::material::{Chaboche, ElastoPlastic, Hardening, Hill48, LinearElastic, Material};
 use crate::mesh::{End, Grading, Mesh};
 use crate::tool::schedule::{ScalarSchedule, Schedule};
 use crate::tool::Tool;
@@ -345,6 +345,42 @@ fn register_material(engine: &mut Engine) {
             ))))
         },
     );
+    register_kinematic(engine);
+}
+
+/// Mixed hardening: `chaboche([[C1, g1], ...])` (one to three Armstrong-Frederick terms)
+/// and `elastoplastic(E, nu, yield, hardening, kinematic)`, the isotropic law and the back
+/// stresses together (`material::kinematic`).
+fn register_kinematic(engine: &mut Engine) {
+    engine.register_type_with_name::<Chaboche>("KinematicHardening");
+    engine.register_fn("chaboche", |terms: Array| -> ScriptResult<Chaboche> {
+        let mut pairs = Vec::new();
+        for (i, term) in terms.iter().enumerate() {
+            let what = format!("chaboche term {} ([C, gamma])", i + 1);
+            let Some(pair) = term.clone().try_cast::<Array>().filter(|p| p.len() == 2) else {
+                return runtime_error(format!("{what} must be a pair [C, gamma], got {term}"));
+            };
+            pairs.push((number(&pair[0], &what)?, number(&pair[1], &what)?));
+        }
+        lift(Chaboche::new(&pairs))
+    });
+    engine.register_fn(
+        "elastoplastic",
+        |e: Dynamic,
+         nu: Dynamic,
+         yield_function: Hill48,
+         hardening: Hardening,
+         kinematic: Chaboche|
+         -> ScriptResult<ScriptMaterial> {
+            let elastic = lift(LinearElastic::new(
+                number(&e, "Young's modulus")?,
+                number(&nu, "Poisson's ratio")?,
+            ))?;
+            Ok(ScriptMaterial(Arc::new(
+                ElastoPlastic::new(elastic, yield_function, hardening).with_kinematic(kinematic),
+            )))
+        },
+    );
 }
 
 /// The rolling direction as an angle from x in radians, from degrees or from a vector
@@ -499,4 +535,46 @@ fn register_tools(engine: &mut Engine) {
             t.friction.describe()
         )
     });
+}
+
+#[cfg(test)]
+mod kinematic_tests {
+    use super::ScriptMaterial;
+    use crate::script::{engine, HostOptions};
+
+    fn eval(src: &str) -> Result<ScriptMaterial, String> {
+        engine(&HostOptions::default(), None)
+            .eval::<ScriptMaterial>(src)
+            .map_err(|e| e.to_string())
+    }
+
+    /// `chaboche` composes with every isotropic law and yield function through the
+    /// five-argument `elastoplastic`; bad terms are errors naming the term and value.
+    #[test]
+    fn chaboche_from_a_script() {
+        let m = eval(
+            "elastoplastic(210000, 0.3, hill48(0.7, 1.3, 2.1), swift(500, 0.01, 0.22), \
+             chaboche([[30000, 200], [5000, 20.0]]))",
+        )
+        .unwrap();
+        let d = format!("{:?}", m.0);
+        assert!(d.contains("Chaboche") && d.contains("30000"), "{d}");
+        let m = eval(
+            "elastoplastic(210000, 0.3, von_mises(), voce(200, 100, 8), chaboche([[1000, 0]]))",
+        );
+        assert!(m.is_ok());
+        let err = eval("chaboche([[30000, 200], [-5, 1]])")
+            .map(|_| ())
+            .unwrap_err();
+        assert!(err.contains("Chaboche term 2 C = -5"), "{err}");
+        let err = eval("chaboche([[1, 1], [1, 1], [1, 1], [1, 1]])")
+            .map(|_| ())
+            .unwrap_err();
+        assert!(err.contains("number of terms = 4"), "{err}");
+        let err = eval("chaboche([[1000]])").map(|_| ()).unwrap_err();
+        assert!(
+            err.contains("chaboche term 1") && err.contains("[C, gamma]"),
+            "{err}"
+        );
+    }
 }
