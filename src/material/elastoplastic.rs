@@ -382,6 +382,13 @@ impl Material for ElastoPlastic {
             .equivalent_stress(state.material_stress(finite))
     }
 
+    fn hardening_exponent(&self) -> Option<f64> {
+        match self.hardening {
+            Hardening::Swift { n, .. } => Some(n),
+            _ => None,
+        }
+    }
+
     fn describe(&self) -> String {
         format!(
             "elastoplastic E={} nu={}, {}, {}",

@@ -8,6 +8,9 @@
 //!   negative: bottom and top face swapped) is renumbered `[4, 5, 6, 7, 0, 1, 2, 3]`; one
 //!   with mixed signs is refused, naming the file's element and line.
 //! * Face sets given by 4 nodes are matched to the element face with those nodes.
+//! * The through-thickness node columns are found from the topology
+//!   ([`Mesh::detect_columns`], `columns.rs`), elements renumbered to stand in them; a mesh
+//!   that is no sheet gets none, and the reason is kept for the solid-shell's error.
 
 use std::collections::BTreeMap;
 
@@ -83,6 +86,7 @@ impl Imported {
             hexes.push(h);
         }
         let mut mesh = Mesh::new(nodes, hexes)?;
+        mesh.detect_columns();
         for (name, set) in &self.node_sets {
             let kept = set
                 .iter()
