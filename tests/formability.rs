@@ -222,3 +222,57 @@ fn plane_strain_beyond_the_curve_is_a_crack() {
     assert!(first.iter().all(|&z| z == Zone::RiskOfCrack.code() as f64 || z == Zone::Safe.code() as f64));
     let _ = FormabilityOptions::default();
 }
+
+/// Through the script layer: a sheet pulled in plane strain with an FLC table and a
+/// thinning limit from the settings; summary.json's `formability` names the largest
+/// thinning and smallest margin where the frame has them, counts every node in one zone,
+/// and reports the table; the FLD and thinning map are written under 200 kB.
+#[test]
+fn summary_and_charts_of_a_scripted_stretch() {
+    let dir = std::env::temp_dir().join(format!("tribo-formability-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("stretch.rhai");
+    std::fs::write(
+        &script,
+        r#"
+let mesh = block([0.0, 0.0, 0.0], [10.0, 10.0, 1.0], [4, 4, 1]);
+let sim = simulation(mesh, elastoplastic(210000.0, 0.3, von_mises(), swift(565.0, 0.007, 0.26)));
+sim.fix("x-", "x");
+sim.fix("y-", "y");
+sim.fix("y+", "y");
+sim.fix("z-", "z");
+sim.prescribe("x+", "x", [[0.0, 0.0], [1.0, 2.0]]);
+sim.settings(#{ end_time: 1.0, increments: 4, kinematics: "finite",
+                flc: [[-0.2, 0.35], [0.0, 0.15], [0.2, 0.3]], thinning_limit: 10.0 });
+sim.run();
+sim.chart_fld("fld.svg");
+sim.chart_field("thinning.svg", "z+", "thinning");
+"#,
+    )
+    .unwrap();
+    let host = tribo::script::HostOptions {
+        out_dir: dir.join("out"),
+        ..tribo::script::HostOptions::default()
+    };
+    tribo::script::run_file(&script, &[], &host).unwrap();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap()).unwrap();
+    let f = &summary["formability"];
+    // Plane strain to ln(1.2) = 0.18 > 0.15: every column beyond the table's curve.
+    assert_eq!(f["worst_zone"], "crack", "{f}");
+    assert_eq!(f["nodes_per_zone"]["crack"], 50, "{f}");
+    let total: u64 = (f["nodes_per_zone"].as_object().unwrap().values()).map(|v| v.as_u64().unwrap()).sum();
+    assert_eq!(total, 50);
+    assert_eq!(f["flc"]["kind"], "table");
+    let margin = f["min_flc_margin"].as_f64().unwrap();
+    assert!((margin - (0.15 - 1.2_f64.ln())).abs() < 1e-6, "{margin}");
+    let thinning = f["max_thinning_pct"].as_f64().unwrap();
+    assert!(thinning > 10.0 && thinning < 20.0, "{thinning}");
+    assert!(f["max_thinning_at"]["node"].is_u64());
+    for chart in ["fld.svg", "fld.csv", "thinning.svg", "thinning.csv"] {
+        let size = std::fs::metadata(dir.join("out").join(chart)).unwrap().len();
+        assert!(size > 0 && size < 200_000, "{chart}: {size} bytes");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

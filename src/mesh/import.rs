@@ -86,7 +86,6 @@ impl Imported {
             hexes.push(h);
         }
         let mut mesh = Mesh::new(nodes, hexes)?;
-        mesh.detect_columns();
         for (name, set) in &self.node_sets {
             let kept = set
                 .iter()
@@ -127,6 +126,8 @@ impl Imported {
                 mesh.add_node_set(name, nodes)?;
             }
         }
+        // Last: it may renumber elements, and face sets above name faces by local index.
+        mesh.detect_columns();
         Ok(mesh)
     }
 }
