@@ -132,8 +132,8 @@ pub fn fields(f: &Formability, node_count: usize, columns: &[Vec<usize>]) -> Vec
 }
 
 /// summary.json's `formability`: the largest thinning and the smallest margin with where
-/// (node at the column's mid-height, its reference and current coordinates), the nodes per
-/// zone, the worst zone and the curve.
+/// (the column's middle node, the top one of a one-layer column, with its reference and
+/// current coordinates), the nodes per zone, the worst zone and the curve.
 pub fn summary(sim: &Simulation, f: &Formability) -> serde_json::Value {
     let mesh = &sim.model.mesh;
     let u = sim.displacements();
