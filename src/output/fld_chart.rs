@@ -15,9 +15,11 @@ use crate::Result;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// The FLD's content: the points, the curve and margin, the title (the material's name).
+/// The FLD's content: the points, the curve and margin, the title and a subtitle (the
+/// material's description).
 pub struct FldChart<'a> {
     pub title: String,
+    pub subtitle: String,
     pub formability: &'a Formability,
     pub safety_margin: f64,
 }
@@ -39,21 +41,25 @@ impl FldChart<'_> {
         let pct = |v: f64| 100.0 * v;
         let (mut x_lo, mut x_hi) = data_range(minor.iter().map(|&v| pct(v)));
         let (mut y_lo, mut y_hi) = data_range(major.iter().map(|&v| pct(v)));
-        x_lo = x_lo.min(-10.0);
-        x_hi = x_hi.max(10.0);
-        y_lo = y_lo.min(0.0);
+        // A margin of 5 % of the span around the points, so none sits on the frame.
+        let (dx, dy) = (0.05 * (x_hi - x_lo), 0.05 * (y_hi - y_lo));
+        x_lo = (x_lo - dx).min(-10.0);
+        x_hi = (x_hi + dx).max(10.0);
+        y_lo = (y_lo - dy).min(0.0);
+        y_hi += dy;
         if let Some(flc) = &f.flc {
             y_hi = y_hi.max(pct(flc.major_limit(0.0)) * 1.2);
         }
         let (x0, x1, xt, xs) = axis(x_lo, x_hi, 8);
         let (y0, y1, yt, ys) = axis(y_lo, y_hi, 8);
         let (width, height) = (760.0, 560.0);
-        let (left, right, top, bottom) = (80.0, width - 200.0, 50.0, height - 60.0);
+        let (left, right, top, bottom) = (80.0, width - 200.0, 62.0, height - 60.0);
         let sx = |x: f64| left + (x - x0) / (x1 - x0) * (right - left);
         let sy = |y: f64| bottom - (y - y0) / (y1 - y0) * (bottom - top);
         let mut out = String::new();
         svg_open(&mut out, width, height);
-        text(&mut out, (left + right) / 2.0, 28.0, 17.0, "middle", " font-weight=\"bold\"", &self.title);
+        text(&mut out, (left + right) / 2.0, 26.0, 17.0, "middle", " font-weight=\"bold\"", &self.title);
+        text(&mut out, (left + right) / 2.0, 46.0, 11.0, "middle", "", &self.subtitle);
         out.push_str("<g stroke=\"#e0e0e0\" stroke-width=\"1\">\n");
         for &t in &xt {
             let _ = writeln!(out, "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\"/>", px(sx(t)), px(top), px(bottom));
@@ -184,7 +190,12 @@ mod tests {
             })
             .collect();
         let f = Formability { flc: Some(flc), columns, margin, zone };
-        let chart = FldChart { title: "DC04 <steel>".into(), formability: &f, safety_margin: 0.1 };
+        let chart = FldChart {
+            title: "DC04 <steel>".into(),
+            subtitle: "Swift n = 0.2".into(),
+            formability: &f,
+            safety_margin: 0.1,
+        };
         let svg = chart.to_svg();
         assert_well_formed(&svg);
         assert_eq!(svg.matches("<circle").count(), 3 + 7, "3 points and 7 legend markers");

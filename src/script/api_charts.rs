@@ -211,8 +211,11 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                 );
             };
             let chart = crate::output::fld_chart::FldChart {
-                title: format!("FLD at t = {}: {}", crate::output::significant(sim.time(), 6),
-                               sim.model.material.describe()),
+                title: format!(
+                    "Forming limit diagram, t = {}",
+                    crate::output::significant(sim.time(), 6)
+                ),
+                subtitle: sim.model.material.describe(),
                 formability: &f,
                 safety_margin: options.thresholds.safety_margin,
             };
