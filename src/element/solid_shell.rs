@@ -286,12 +286,13 @@ pub fn select(
 /// (its `ζ` axis is the thickness direction). Errors name the fault and the element.
 pub fn check_columns(mesh: &Mesh) -> Result<()> {
     if mesh.columns().is_empty() {
-        return Err(Error::Input(
-            "element \"solid_shell\": the mesh has no through-thickness node columns (a block \
-             mesh has them, also after mesh.map); the solid-shell takes its thickness \
+        let why = mesh.columns_fault().map(|f| format!(": {f}")).unwrap_or_default();
+        return Err(Error::Input(format!(
+            "element \"solid_shell\": the mesh has no through-thickness node columns{why} (a \
+             block mesh has them, also after mesh.map, and an imported or merged sheet of \
+             hexahedra stacked through its thickness); the solid-shell takes its thickness \
              direction from them"
-                .into(),
-        ));
+        )));
     }
     let mut place = vec![None; mesh.node_count()];
     for (c, col) in mesh.columns().iter().enumerate() {

@@ -465,6 +465,13 @@ impl Material for ElastoPlastic {
             .equivalent_stress(&(state.material_stress(finite) - state.total_back_stress()))
     }
 
+    fn hardening_exponent(&self) -> Option<f64> {
+        match self.hardening {
+            Hardening::Swift { n, .. } => Some(n),
+            _ => None,
+        }
+    }
+
     fn describe(&self) -> String {
         let kinematic = self
             .kinematic

@@ -301,6 +301,12 @@ pub trait Material: std::fmt::Debug + Send + Sync {
 
     /// A short human-readable description ("linear elastic E=210000 nu=0.3") for logs.
     fn describe(&self) -> String;
+
+    /// The strain-hardening exponent `n` of a Swift law `C (ε0 + ε̄p)^n`, when the model
+    /// hardens by one: the default forming limit curve (Keeler-Brazier) is built from it.
+    fn hardening_exponent(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// Strain tensor from a Voigt strain vector with engineering shear (halves the shears).

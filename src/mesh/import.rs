@@ -8,6 +8,9 @@
 //!   negative: bottom and top face swapped) is renumbered `[4, 5, 6, 7, 0, 1, 2, 3]`; one
 //!   with mixed signs is refused, naming the file's element and line.
 //! * Face sets given by 4 nodes are matched to the element face with those nodes.
+//! * The through-thickness node columns are found from the topology
+//!   ([`Mesh::detect_columns`], `columns.rs`), elements renumbered to stand in them; a mesh
+//!   that is no sheet gets none, and the reason is kept for the solid-shell's error.
 
 use std::collections::BTreeMap;
 
@@ -123,6 +126,8 @@ impl Imported {
                 mesh.add_node_set(name, nodes)?;
             }
         }
+        // Last: it may renumber elements, and face sets above name faces by local index.
+        mesh.detect_columns();
         Ok(mesh)
     }
 }

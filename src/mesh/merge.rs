@@ -4,8 +4,9 @@
 //!
 //! Coincidence is found with a hash of positions quantised to cells of the tolerance's
 //! size, looking in the 27 neighbouring cells: O(n) expected. Sets of the same name are
-//! united (node, element and face sets), columns are kept from both meshes (a column of
-//! the second mesh that coincides with one of the first is kept once). The meshes must
+//! united (node, element and face sets). The through-thickness columns of the result are
+//! found from its topology ([`Mesh::detect_columns`]): two sheets side by side or stacked
+//! through the thickness are one sheet; a result that is no sheet has none. The meshes must
 //! conform on the shared face: a node of one lying on a face of the other without a twin
 //! (a hanging node) is not detected here.
 
@@ -88,7 +89,8 @@ impl Mesh {
             nodes,
             hexes,
             node_sets: self.node_sets.clone(),
-            columns: self.columns.clone(),
+            columns: Vec::new(),
+            columns_fault: None,
             sets: self.sets.clone(),
         };
         mesh.validate()?;
@@ -122,12 +124,7 @@ impl Mesh {
             }
             mesh.add_face_set(name, &pairs)?;
         }
-        for col in &other.columns {
-            let mapped: Vec<usize> = col.iter().map(|&n| map[n]).collect();
-            if !mesh.columns.contains(&mapped) {
-                mesh.columns.push(mapped);
-            }
-        }
+        mesh.detect_columns();
         Ok(mesh)
     }
 }

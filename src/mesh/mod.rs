@@ -32,6 +32,7 @@ use crate::geometry::{Mat3, Vec3};
 use crate::{Error, Result};
 
 mod block;
+mod columns;
 mod faces;
 pub mod gmsh;
 mod grading;
@@ -89,6 +90,8 @@ pub struct Mesh {
     node_sets: BTreeMap<String, Vec<usize>>,
     /// Through-thickness node columns of a sheet (see [`Mesh::columns`]).
     columns: Vec<Vec<usize>>,
+    /// Why [`Mesh::detect_columns`] found no columns (`columns.rs`), naming the element.
+    columns_fault: Option<String>,
     /// Named element sets and face sets of imported meshes (see `sets.rs`).
     sets: sets::Sets,
 }
@@ -107,8 +110,8 @@ impl Mesh {
     }
 
     /// Through-thickness node columns, bottom to top, when the mesh is a sheet whose
-    /// thickness direction is known (a block: its z axis, the sheet normal); empty
-    /// otherwise. Each column's current length is the sheet's current thickness there.
+    /// thickness direction is known (a block: its z axis, the sheet normal; an imported or
+    /// merged mesh: found from its topology, `columns.rs`); empty otherwise. Each column's current length is the sheet's current thickness there.
     pub fn columns(&self) -> &[Vec<usize>] {
         &self.columns
     }

@@ -7,6 +7,7 @@
 //! `frame_points: "reference"` writes the reference coordinates instead (one mesh for every
 //! frame, for Warp By Vector with a chosen scale). Cost: O(nodes + contact pairs + points).
 
+use super::formability::FormabilityOptions;
 use super::{Field, Frame};
 use crate::contact::ContactStatus;
 use crate::element::StrainTheory;
@@ -127,7 +128,8 @@ fn nodal_contact(sim: &Simulation, only: Option<usize>) -> NodalContact {
 
 /// The committed state as a VTK frame, points in `configuration`: displacement and contact
 /// fields on the nodes (and, for sheet meshes with through-thickness columns, the current
-/// thickness and the thickness strain ln(t/t0) of each column on its nodes),
+/// thickness, the thickness strain ln(t/t0) and the formability fields of each column on
+/// its nodes, with the default curve and thresholds),
 /// element-averaged Cauchy stress (components named xx, yy, zz, xy, yz, xz), von Mises
 /// stress (of that mean), the mean of the points' equivalent stress of the material's
 /// yield function (Hill48's `φ` of the stress the material works in, which plastic points
@@ -136,12 +138,18 @@ fn nodal_contact(sim: &Simulation, only: Option<usize>) -> NodalContact {
 /// strain on the cells; for solid-shell models also the values
 /// at the faces and the mid-surface (`shell_layers`).
 pub fn frame(sim: &Simulation, configuration: Configuration) -> Frame {
-    frame_against(sim, configuration, None)
+    frame_against(sim, configuration, None, &FormabilityOptions::default())
 }
 
 /// As [`frame`], with the contact fields of tool `only` alone when given (a chart of the
-/// punch side shows the punch's work, not the holder's).
-pub fn frame_against(sim: &Simulation, configuration: Configuration, only: Option<usize>) -> Frame {
+/// punch side shows the punch's work, not the holder's), and the formability fields
+/// (`thinning`, `major_strain`, ..., formability/) of `formability`'s curve and thresholds.
+pub fn frame_against(
+    sim: &Simulation,
+    configuration: Configuration,
+    only: Option<usize>,
+    formability: &FormabilityOptions,
+) -> Frame {
     let mesh = &sim.model.mesh;
     let n = mesh.nodes.len();
     let u = sim.displacements();
@@ -168,22 +176,22 @@ pub fn frame_against(sim: &Simulation, configuration: Configuration, only: Optio
             + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]))
             .sqrt();
     }
-    // Sheet thickness per through-thickness column (block meshes), on the column's nodes.
+    // Sheet thickness per through-thickness column, on the column's nodes, and the
+    // formability fields (formability/).
     let mut sheet_fields = Vec::new();
-    if !mesh.columns().is_empty() {
-        let disp = |n: usize| Vec3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2]);
-        let current = mesh.column_thicknesses(disp);
-        let initial = mesh.column_thicknesses(|_| Vec3::zeros());
+    if let Some(f) = super::formability::evaluate(sim, formability) {
         let mut thickness = vec![0.0; n];
         let mut thickness_strain = vec![0.0; n];
         for (k, col) in mesh.columns().iter().enumerate() {
             for &node in col {
-                thickness[node] = current[k];
-                thickness_strain[node] = (current[k] / initial[k]).ln();
+                thickness[node] = f.columns.thickness[k];
+                thickness_strain[node] =
+                    (f.columns.thickness[k] / f.columns.initial_thickness[k]).ln();
             }
         }
         sheet_fields.push(Field::scalar("thickness", thickness));
         sheet_fields.push(Field::scalar("thickness_strain", thickness_strain));
+        sheet_fields.extend(super::formability::fields(&f, n, mesh.columns()));
     }
     Frame {
         points: (mesh.nodes.iter().enumerate())

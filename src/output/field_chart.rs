@@ -84,6 +84,8 @@ pub struct MapView {
     pub tool: Option<String>,
     /// Unit of x and y ("mm"); empty for none.
     pub length_unit: String,
+    /// The curve and thresholds of the formability fields (`flc_margin`, `formability`).
+    pub formability: super::formability::FormabilityOptions,
 }
 
 /// The colour map of field `field` on the boundary faces within node set `face_set`,
@@ -107,7 +109,8 @@ pub fn field_map(
         .as_deref()
         .map(|name| sim.model.tool_index(name))
         .transpose()?;
-    let frame = super::blank_frame::frame_against(sim, Configuration::Reference, tool);
+    let frame =
+        super::blank_frame::frame_against(sim, Configuration::Reference, tool, &view.formability);
     let mut values = nodal_values(&frame, field)?;
     if let Some(c) = tool {
         let mut touched = vec![false; values.len()];

@@ -81,6 +81,8 @@ pub struct OutputOptions {
     /// Fraction of the physical part the model is (1/4 for a quarter model with two planes
     /// of symmetry): forces, works and energies are the model's.
     pub model_fraction: f64,
+    /// The forming limit curve and zone thresholds of the formability fields.
+    pub formability: super::formability::FormabilityOptions,
 }
 
 impl OutputOptions {
@@ -92,6 +94,7 @@ impl OutputOptions {
             cadence: Cadence::default_for(end_time),
             units: Units::default(),
             model_fraction: 1.0,
+            formability: Default::default(),
         }
     }
 }
@@ -333,7 +336,7 @@ impl RunOutput {
         let files = self.frame_files(sim, index);
         write_vtu(
             &self.folder.resolve_for_write(&files[0].1)?,
-            &blank_frame::frame(sim, self.frames.points),
+            &blank_frame::frame_against(sim, self.frames.points, None, &self.frames.formability),
         )?;
         let mut tool_files = files[1..].iter();
         let region = tool_frame::DisplayRegion::around(&sim.model.mesh.nodes);
@@ -531,6 +534,8 @@ impl RunOutput {
             "discarded_iterations": sim.history.iter().map(|r| r.discarded_iterations).sum::<usize>(),
             "increments_with_cycling": sim.history.iter().filter(|r| !r.cycling.is_empty()).count(),
             "step_control": format!("{:?}", settings.stepping.mode).to_lowercase(),
+            "formability": super::formability::evaluate(sim, &self.frames.formability)
+                .map(|f| super::formability::summary(sim, &f)),
         });
         if let Some(map) = summary.as_object_mut() {
             if !sim.model.steps.is_empty() {

@@ -163,6 +163,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             let path = chart_path(&h, file)?;
             let mut st = s.borrow_mut();
             view.length_unit = st.length_unit();
+            view.formability = st.formability();
             let sim = st.simulation()?;
             let mut map = lift(field_map(sim, face_set, field, &view))?;
             map.title = title.unwrap_or(map.title);
@@ -193,6 +194,32 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                     Map::new(),
                 ),
             )
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "chart_fld",
+        move |s: &mut ScriptSim, file: &str| -> ScriptResult<()> {
+            let path = chart_path(&h, file)?;
+            let mut st = s.borrow_mut();
+            let options = st.formability();
+            let sim = st.simulation()?;
+            let Some(f) = crate::output::formability::evaluate(sim, &options) else {
+                return runtime_error(
+                    "chart_fld: the mesh has no through-thickness node columns (no sheet), so no \
+                     forming limit diagram",
+                );
+            };
+            let chart = crate::output::fld_chart::FldChart {
+                title: format!(
+                    "Forming limit diagram, t = {}",
+                    crate::output::significant(sim.time(), 6)
+                ),
+                subtitle: sim.model.material.describe(),
+                formability: &f,
+                safety_margin: options.thresholds.safety_margin,
+            };
+            lift(chart.write(&path).map(|_| ()))
         },
     );
     engine.register_fn(

@@ -431,6 +431,11 @@ impl SimState {
         })
     }
 
+    /// The forming limit curve and zone thresholds of the settings.
+    pub(super) fn formability(&self) -> crate::output::formability::FormabilityOptions {
+        self.frames.formability.clone()
+    }
+
     /// The length unit named in the output settings ("" when none was set).
     pub(super) fn length_unit(&self) -> String {
         self.frames.units.length.clone()
@@ -525,6 +530,17 @@ impl SimState {
         self.wall_time = Some(wall);
         if let (Some(out), Some(sim)) = (self.output.as_mut(), self.sim.as_ref()) {
             lift(out.write_summary(sim, wall, None))?;
+        }
+        // The forming engineer's first answer: the largest thinning and the worst zone.
+        if let Some(sim) = self.sim.as_ref() {
+            if let Some(f) = crate::output::formability::evaluate(sim, &self.frames.formability) {
+                for line in crate::output::formability::terminal_lines(&f) {
+                    match &self.progress {
+                        Some(bar) => bar.suspend(|| eprintln!("{line}")),
+                        None => eprintln!("{line}"),
+                    }
+                }
+            }
         }
         Ok(())
     }

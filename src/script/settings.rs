@@ -10,6 +10,7 @@
 use super::convert::*;
 use crate::contact::{Enforcement, FrameUpdate, FrictionUpdate};
 use crate::element::{ElementKind, StrainTheory};
+use crate::output::formability::{Flc, FormabilityOptions};
 use crate::output::{Cadence, Configuration, OutputOptions, Units};
 use crate::solver::{AntiCycling, LinearSolverKind, SolverSettings, StepMode};
 use crate::Error;
@@ -25,6 +26,8 @@ pub(super) struct FrameKnobs {
     points: Configuration,
     pub(super) units: Units,
     model_fraction: f64,
+    /// The forming limit curve and zone thresholds (`flc`, `flc_safety_margin`, ...).
+    pub(super) formability: FormabilityOptions,
 }
 
 impl Default for FrameKnobs {
@@ -35,6 +38,7 @@ impl Default for FrameKnobs {
             points: Configuration::Current,
             units: Units::default(),
             model_fraction: 1.0,
+            formability: FormabilityOptions::default(),
         }
     }
 }
@@ -48,6 +52,7 @@ impl FrameKnobs {
                 .unwrap_or_else(|| Cadence::default_for(end_time)),
             units: self.units.clone(),
             model_fraction: self.model_fraction,
+            formability: self.formability.clone(),
         }
     }
 }
@@ -146,6 +151,27 @@ pub(super) const SETTINGS: &[Setting] = &[
             ));
         }
         k.frames.model_fraction = f;
+        Ok(())
+    }),
+    // Formability: the forming limit curve and the zone thresholds.
+    setting("flc", "[[-0.2, 0.5], [0.0, 0.3], [0.3, 0.45]]", |_, k, v| {
+        k.frames.formability.flc = Some(flc_table(v)?);
+        Ok(())
+    }),
+    setting("flc_safety_margin", "0.05", |_, k, v| {
+        k.frames.formability.thresholds.safety_margin = non_negative(v)?;
+        Ok(())
+    }),
+    setting("thinning_limit", "20.0", |_, k, v| {
+        k.frames.formability.thresholds.thinning_limit = non_negative(v)?;
+        Ok(())
+    }),
+    setting("stretch_limit", "0.01", |_, k, v| {
+        k.frames.formability.thresholds.stretch_limit = non_negative(v)?;
+        Ok(())
+    }),
+    setting("wrinkle_limit", "0.03", |_, k, v| {
+        k.frames.formability.thresholds.wrinkle_limit = non_negative(v)?;
         Ok(())
     }),
     setting("checkpoint_every", "5", |_, k, v| {
@@ -419,6 +445,37 @@ impl Value<'_> {
             )),
         }
     }
+}
+
+/// A finite number >= 0.
+fn non_negative(v: Value) -> ScriptResult<f64> {
+    let x = v.number()?;
+    if x.is_finite() && x >= 0.0 {
+        Ok(x)
+    } else {
+        fail(Error::input(v.key, x, "must be finite and >= 0"))
+    }
+}
+
+/// `flc: [[minor, major], ...]`, true strains, minor strictly increasing.
+fn flc_table(v: Value) -> ScriptResult<Flc> {
+    let Some(rows) = v.v.clone().try_cast::<rhai::Array>() else {
+        return runtime_error(format!(
+            "{} must be an array of [minor, major] pairs, got {}",
+            v.key,
+            v.v.type_name()
+        ));
+    };
+    let mut points = Vec::with_capacity(rows.len());
+    for (i, row) in rows.iter().enumerate() {
+        let pair = row.clone().try_cast::<rhai::Array>().filter(|r| r.len() == 2);
+        let Some(pair) = pair else {
+            return runtime_error(format!("{} point {i} must be a [minor, major] pair", v.key));
+        };
+        let at = format!("{} point {i}", v.key);
+        points.push([number(&pair[0], &at)?, number(&pair[1], &at)?]);
+    }
+    lift(Flc::table(points))
 }
 
 /// `increments`: a whole number from 1 to the `--max-increments` cap.
