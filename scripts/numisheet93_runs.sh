@@ -2,8 +2,9 @@
 # The runs behind docs/validation/numisheet93.md: NUMISHEET'93 benchmark variant to 40 mm,
 # one-layer solid-shell sheets, Hill48, both benchmark sheets, and the sensitivity runs.
 # Each run writes its own folder under OUT (default out/numisheet93) with summary.json and
-# cpu.txt (/usr/bin/time -v: CPU seconds and peak memory); a run whose summary.json exists is
-# skipped, so the script can be re-entered. Runs niced (the machine is shared).
+# cpu.txt (/usr/bin/time -v: CPU seconds and peak memory); a run whose folder exists is
+# skipped, so the script can be re-entered, and run twice at once on the same OUT to use both
+# cores. Runs niced (the machine is shared).
 #
 #   scripts/numisheet93_runs.sh [OUT] [GROUP...]      GROUP: base25 pair25 sens25 base50 base100 fbar25
 #   python3 scripts/numisheet93_report.py OUT         # writes docs/validation/numisheet93.md + SVG
@@ -17,11 +18,15 @@ mkdir -p "$out"
 run() { # name, then --set arguments
     local name=$1; shift
     local dir="$out/$name"
-    if [[ -f "$dir/summary.json" ]]; then echo "skip $name (done)"; return; fi
+    # A folder that exists is a run done or under way (two runners may share OUT); delete a
+    # failed run's folder to run it again.
+    if [[ -d "$dir" ]]; then echo "skip $name (done or under way)"; return; fi
     mkdir -p "$dir"
     echo "run  $name: $*"
-    local sets=()
-    for s in variant='"benchmark"' element='"solid_shell"' layers=1 charts=false "$@"; do
+    local sets=() defaults=(variant='"benchmark"' layers=1 charts=false)
+    # The solid-shell unless the run names its element (a --set may name a variable once).
+    [[ " $* " == *" element="* ]] || defaults+=(element='"solid_shell"')
+    for s in "${defaults[@]}" "$@"; do
         sets+=(--set "$s")
     done
     nice -n 19 /usr/bin/time -v -o "$dir/cpu.txt" "$tribo" run scripts/square_cup.rhai --quiet \
