@@ -18,6 +18,7 @@ fn run(tag: &str, extra: &[&str]) -> Value {
         .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
         .arg(&out)
         .args(["--set", "travel=6.0", "--set", "charts=false"])
+        .args(["--set", "element=\"hexahedron\""])
         .args(extra)
         .status()
         .expect("tribo runs");

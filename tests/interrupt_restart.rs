@@ -19,6 +19,7 @@ fn cup(out: &Path, restart: Option<&Path>) -> Command {
     let mut cmd = Command::new(BIN);
     cmd.args(["run", "scripts/square_cup.rhai", "--quiet"])
         .args(["--set", "cells=8", "--set", "step=0.5"])
+        .args(["--set", "element=\"hexahedron\""])
         .arg("--out")
         .arg(out)
         .current_dir(env!("CARGO_MANIFEST_DIR"))

@@ -400,6 +400,8 @@ fn the_cups_frames_hold_every_tool_at_its_scheduled_pose() {
             "travel=2.0",
             "--set",
             "charts=false",
+            "--set",
+            "element=\"hexahedron\"",
         ])
         .status()
         .expect("tribo runs");

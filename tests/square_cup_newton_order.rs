@@ -60,6 +60,8 @@ fn run_cup(variant: &str) -> Value {
             "travel=15.0",
             "--set",
             "charts=false",
+            "--set",
+            "element=\"hexahedron\"",
         ])
         .arg("--set")
         .arg(format!("variant=\"{variant}\""))
