@@ -25,12 +25,14 @@ fn step_tool(name: &str) -> PatchSurface {
     tool_surface(&source, faces, &ImportOptions::default()).unwrap()
 }
 
-/// The punch and die of a format: NURBS-converted IGES or STEP, or the IGES of OCC's own
-/// analytic faces (planes and surfaces of revolution).
+/// The punch and die of a format: NURBS-converted IGES or STEP, or the IGES or STEP of
+/// OCC's own analytic faces (IGES: planes and surfaces of revolution; STEP: planes,
+/// cylinders, tori).
 fn cad_tool(format: &str, which: &str) -> PatchSurface {
     match format {
         "igs" => iges_tool(&format!("{which}_nurbs.igs"), &ImportOptions::default()),
         "igs-analytic" => iges_tool(&format!("{which}_analytic.igs"), &ImportOptions::default()),
+        "step-analytic" => step_tool(&format!("{which}_analytic.step")),
         _ => step_tool(&format!("{which}_nurbs.step")),
     }
 }
@@ -49,6 +51,15 @@ impl Rng {
 
 /// Largest foot, normal and gap differences between the two surfaces at `points`.
 fn worst_difference(a: &dyn RigidSurface, b: &dyn RigidSurface, points: &[Vec3]) -> [f64; 3] {
+    worst_difference_within(a, b, points, 1e-8)
+}
+
+fn worst_difference_within(
+    a: &dyn RigidSurface,
+    b: &dyn RigidSurface,
+    points: &[Vec3],
+    tol: f64,
+) -> [f64; 3] {
     let mut worst = [0.0f64; 3];
     for x in points {
         let (p, q): (Projection, Projection) = (
@@ -68,7 +79,7 @@ fn worst_difference(a: &dyn RigidSurface, b: &dyn RigidSurface, points: &[Vec3])
             }
         }
         assert!(
-            d.iter().all(|&e| e < 1e-8),
+            d.iter().all(|&e| e < tol),
             "x = {x:?}\n reference {q:?}\n imported  {p:?}"
         );
     }
@@ -102,14 +113,14 @@ fn points_around(
 
 #[test]
 fn imported_punch_equals_the_bezier_builder() {
-    for format in ["igs", "igs-analytic", "step"] {
+    for format in ["igs", "igs-analytic", "step", "step-analytic"] {
         punch_equals_the_builder(format);
     }
 }
 
 #[test]
 fn imported_die_equals_the_bezier_builder_also_above_its_opening() {
-    for format in ["igs", "igs-analytic", "step"] {
+    for format in ["igs", "igs-analytic", "step", "step-analytic"] {
         die_equals_the_builder(format);
     }
 }
@@ -121,10 +132,14 @@ fn punch_equals_the_builder(format: &str) {
     // The CAD punch is a closed solid (a top face at z = 58); the builder's wall is open
     // there: compare below z = 40.
     let points = points_around(&reference, 10_000, 91, |p| p.z < 40.0);
-    let worst = worst_difference(&imported, &reference, &points);
+    // The punch's corner blends are spindle tori (major 2, minor 8), which OpenCascade's
+    // STEP writer puts as a SURFACE_OF_REVOLUTION of a polynomial degree-6 B-spline that
+    // approximates the profile arc to ~1.2e-7 mm: read exactly, it is the file's surface.
+    let tol = if format == "step-analytic" { 1e-6 } else { 1e-8 };
+    let worst = worst_difference_within(&imported, &reference, &points, tol);
     eprintln!("punch ({format}): worst foot, normal, gap differences {worst:?}");
     let seams = imported.seams();
-    assert!(seams.worst_gap < 1e-8, "{seams:?}");
+    assert!(seams.worst_gap < tol, "{seams:?}");
 }
 
 fn die_equals_the_builder(format: &str) {
@@ -154,7 +169,7 @@ fn die_equals_the_builder(format: &str) {
 /// entry radius starts: half side 37 + 8, plan corner 12 + 8), from any point.
 #[test]
 fn trimmed_faces_give_no_foot_outside_their_trims() {
-    for format in ["igs", "igs-analytic", "step"] {
+    for format in ["igs", "igs-analytic", "step", "step-analytic"] {
         no_foot_in_the_opening(format);
     }
 }
@@ -400,12 +415,13 @@ fn bad_step_files_are_refused_naming_what_and_where() {
         e.contains(&format!("wrong.step:{}: #17 (ADVANCED_FACE): its surface #32 is a CARTESIAN_POINT, which is not read", face_line + 1)),
         "{e}"
     );
+    // A surface kind that is not read, named with the kinds that are.
     let (_, analytic) = data("punch_analytic.step");
-    let e = step_refusal("punch_analytic.step", &analytic);
+    let face_line = 1 + analytic.lines().position(|l| l.starts_with("#17 = ADVANCED_FACE(")).unwrap();
+    let unread = analytic.replacen("#32 = PLANE('',#33);", "#32 = CURVE_BOUNDED_SURFACE('',#33);", 1);
+    let e = step_refusal("punch_analytic.step", &unread);
     assert!(
-        e.contains("punch_analytic.step:")
-            && e.contains("which is not read")
-            && e.contains("BRepBuilderAPI_NurbsConvert"),
+        e.contains(&format!("punch_analytic.step:{}: #17 (ADVANCED_FACE): its surface #32 is a CURVE_BOUNDED_SURFACE, which is not read (read: PLANE, CYLINDRICAL_SURFACE", face_line)),
         "{e}"
     );
     let e = step_refusal("notes.step", "punch and die\n");

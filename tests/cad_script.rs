@@ -56,8 +56,8 @@ fn scripts_get_the_file_line_and_entity_of_a_refusal() {
             "face index = 999 must be < the file's face count".to_string(),
         ),
         (
-            format!("tool_from_step(\"{dir}/punch_analytic.step\");"),
-            "punch_analytic.step:".to_string(),
+            format!("tool_from_step(\"{dir}/punch_nurbs.igs\");"),
+            "punch_nurbs.igs:1: no DATA section".to_string(),
         ),
         (
             "tool_from_iges(\"/etc/passwd\");".to_string(),

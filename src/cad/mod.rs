@@ -10,7 +10,9 @@ pub mod iges;
 mod iges_analytic;
 pub mod nurbs_json;
 pub mod step;
+mod step_analytic;
 mod step_assembly;
+mod step_curves;
 
 use crate::geometry::nurbs::NurbsSurface;
 use crate::geometry::trim::{PieceTrim, TrimRegion};

@@ -11,16 +11,27 @@
 //! of it); and the length unit (`SI_UNIT` with its prefix, or a `CONVERSION_BASED_UNIT`
 //! named inch or foot). Faces come out in mm.
 //!
-//! A face on another surface (`PLANE`, `CYLINDRICAL_SURFACE`, `TOROIDAL_SURFACE`, ...) is
-//! refused naming it: export B-splines (OpenCascade: `BRepBuilderAPI_NurbsConvert`). The
-//! edges of a loop are chained by continuity (each one turned so that it starts where the
-//! previous ended), so a loop needs only its pcurves, not the orientation flags.
+//! A face on an analytic surface (`PLANE`, `CYLINDRICAL_SURFACE`, `CONICAL_SURFACE`,
+//! `SPHERICAL_SURFACE`, `TOROIDAL_SURFACE`, `SURFACE_OF_REVOLUTION`,
+//! `SURFACE_OF_LINEAR_EXTRUSION`, `OFFSET_SURFACE` of one) is made the exact NURBS it is in
+//! STEP's own parameters ([`super::step_analytic`]); its line, circle, ellipse and B-spline
+//! pcurves are bounded by the edge's vertices (found on the pcurve by Gauss-Newton on the
+//! surface from the 3-D curve's parameter), an edge with no pcurve on a plane is mapped
+//! onto the plane exactly. Any other surface is refused naming it and the kinds read. The
+//! edges of a loop are chained by continuity: each edge's options (its pcurves, both ways,
+//! and on a periodic surface a turn either side) searched depth first for a closed chain,
+//! so a loop needs only its pcurves, not the orientation flags. A face's outward normal is
+//! its surface's `S_u x S_v` if its `same_sense` is true, the opposite otherwise (a face of
+//! a closed shell or solid then points out of it, as OpenCascade writes them).
 //! Parts placed in an assembly (`CONTEXT_DEPENDENT_SHAPE_REPRESENTATION` with an
 //! `ITEM_DEFINED_TRANSFORMATION`) come out at their placed pose ([`super::step_assembly`]). Every error names the file, the line
 //! and the instance (`#id`); the file's text is never echoed.
 
+use super::step_analytic::Analytic;
+use super::step_curves::{Curve, Frame};
 use super::Face;
-use crate::geometry::nurbs::{check_knots, curve_segments, NurbsSurface};
+use crate::geometry::analytic_nurbs::NurbsCurve;
+use crate::geometry::nurbs::NurbsSurface;
 use crate::geometry::trim::{TrimRegion, TrimSegment};
 use crate::geometry::Vec3;
 use crate::{Error, Result};
@@ -397,7 +408,7 @@ impl<'a> Step<'a> {
             .map(|(_, p)| p.as_slice())
     }
 
-    fn kind(&self, id: usize) -> String {
+    pub(super) fn kind(&self, id: usize) -> String {
         self.instances.get(&id).map_or(String::new(), |i| {
             i.parts
                 .iter()
@@ -434,7 +445,7 @@ impl<'a> Step<'a> {
         }
     }
 
-    fn boolean(&self, id: usize, v: Option<&Value>, what: &str) -> Result<bool> {
+    pub(super) fn boolean(&self, id: usize, v: Option<&Value>, what: &str) -> Result<bool> {
         match v {
             Some(Value::Enum(e)) if e == "T" => Ok(true),
             Some(Value::Enum(e)) if e == "F" => Ok(false),
@@ -457,7 +468,7 @@ impl<'a> Step<'a> {
     }
 
     /// Knots expanded from `(multiplicities)` and `(values)`.
-    fn knots(&self, id: usize, mults: Option<&Value>, values: Option<&Value>) -> Result<Vec<f64>> {
+    pub(super) fn knots(&self, id: usize, mults: Option<&Value>, values: Option<&Value>) -> Result<Vec<f64>> {
         let m = self.list(id, mults, "knot multiplicities")?;
         let k = self.list(id, values, "knot values")?;
         if m.len() != k.len() {
@@ -481,7 +492,7 @@ impl<'a> Step<'a> {
         Ok(out)
     }
 
-    fn degree(&self, id: usize, v: Option<&Value>) -> Result<usize> {
+    pub(super) fn degree(&self, id: usize, v: Option<&Value>) -> Result<usize> {
         let d = self.number(id, v, "degree")?;
         if !(1.0..=64.0).contains(&d) || d.fract() != 0.0 {
             return Err(self.fail(id, format!("degree {d} is not an integer in 1..64")));
@@ -490,7 +501,7 @@ impl<'a> Step<'a> {
     }
 
     /// A B-spline surface instance as a NURBS surface in mm.
-    fn surface(&self, id: usize, face: usize) -> Result<NurbsSurface> {
+    pub(super) fn surface(&self, id: usize, face: usize) -> Result<NurbsSurface> {
         // Simple instance: name, du, dv, points, form, closed u, closed v, self-intersect,
         // u mults, v mults, u knots, v knots, spec. Complex: the same split in parts.
         let (head, knots, weights) = if let Some(p) = self
@@ -514,9 +525,9 @@ impl<'a> Step<'a> {
             return Err(self.fail(
                 face,
                 format!(
-                    "its surface #{id} is a {}, which is not read; export the faces as \
-                     B-spline surfaces (OpenCascade: BRepBuilderAPI_NurbsConvert before writing)",
-                    self.kind(id)
+                    "its surface #{id} is a {}, which is not read (read: {})",
+                    self.kind(id),
+                    super::step_analytic::READ
                 ),
             ));
         };
@@ -573,62 +584,28 @@ impl<'a> Step<'a> {
                 .map(|w| TrimSegment::line([w[0][0], w[0][1]], [w[1][0], w[1][1]]))
                 .collect());
         }
-        let (head, knots, weights) = if let Some(p) = self
-            .part(id, "B_SPLINE_CURVE_WITH_KNOTS")
-            .filter(|p| p.len() == 9)
-        {
-            (&p[1..3], &p[6..8], None)
-        } else if let (Some(b), Some(k)) = (
-            self.part(id, "B_SPLINE_CURVE"),
-            self.part(id, "B_SPLINE_CURVE_WITH_KNOTS"),
-        ) {
-            if b.len() < 2 || k.len() < 2 {
-                return Err(self.fail(id, "too few parameters for a B-spline curve".into()));
-            }
-            (&b[0..2], &k[0..2], self.part(id, "RATIONAL_B_SPLINE_CURVE"))
-        } else {
+        if self.part(id, "B_SPLINE_CURVE_WITH_KNOTS").is_none() {
             return Err(self.fail(id, format!(
-                "a {} as a parameter-space trimming curve is not read (read: B-spline curves, polylines)",
+                "a {} as a parameter-space trimming curve is not read (read: B-spline curves, \
+                 polylines, and lines, circles, ellipses bounded by the edge's vertices)",
                 self.kind(id)
             )));
-        };
-        let p = self.degree(id, head.first())?;
-        let mut uv = Vec::new();
-        for q in self.list(id, head.get(1), "control points")? {
-            let c = self.point(self.reference(id, Some(q), "control point")?, id)?;
-            if c.len() < 2 {
-                return Err(self.fail(id, "a parameter-space point without 2 coordinates".into()));
-            }
-            uv.extend([c[0], c[1]]);
         }
-        let n = uv.len() / 2;
-        let knots = self.knots(id, knots.first(), knots.get(1))?;
-        let w = match weights {
-            None => vec![1.0; n],
-            Some(w) => self
-                .list(id, w.first(), "weights")?
-                .iter()
-                .map(|x| self.number(id, Some(x), "weight"))
-                .collect::<Result<_>>()?,
-        };
-        if w.len() != n || w.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
-            return Err(self.fail(
-                id,
-                format!(
-                    "{} weights for {n} control points, all must be > 0",
-                    w.len()
-                ),
-            ));
-        }
-        check_knots("curve", p, n, &knots).map_err(|e| self.fail(id, super::strip(e)))?;
-        Ok(curve_segments(p, &knots, &uv, &w, 2, [knots[p], knots[n]])
-            .into_iter()
-            .map(|(h, _)| TrimSegment::new(h.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()))
-            .collect())
+        Ok(segments_2d(&self.spline_curve(id)?))
     }
 
-    /// The pcurves on `surface` of an edge's curve, each as trimming segments.
-    fn edge_pcurves(&self, edge: usize, surface: usize) -> Result<Vec<Vec<TrimSegment>>> {
+    /// The trimming segments on `surface` of an edge: one chain per pcurve of the edge on
+    /// that surface (a seam has two). A B-spline or polyline pcurve is taken whole; a line,
+    /// circle or ellipse pcurve runs over the edge's parameter range on its 3-D curve
+    /// ([`Step::edge_range`]), the pcurve sharing the 3-D curve's parameter (OpenCascade's
+    /// same-parameter edges), which is checked on the analytic surface. An edge with no
+    /// pcurve on a plane is mapped onto the plane exactly.
+    fn edge_pcurves(
+        &self,
+        edge: usize,
+        surface: usize,
+        analytic: Option<&Analytic>,
+    ) -> Result<Vec<Vec<TrimSegment>>> {
         let e = self.part(edge, "EDGE_CURVE").ok_or_else(|| {
             self.fail(
                 edge,
@@ -636,14 +613,19 @@ impl<'a> Step<'a> {
             )
         })?;
         let geometry = self.reference(edge, e.get(3), "edge geometry")?;
+        self.instance(geometry, edge, "edge geometry")?;
         let g = self
             .part(geometry, "SURFACE_CURVE")
-            .or_else(|| self.part(geometry, "SEAM_CURVE"))
-            .ok_or_else(|| {
-                self.fail(geometry, "an edge curve without parameter-space curves (a SURFACE_CURVE with PCURVEs) is not read".into())
-            })?;
-        let mut out = Vec::new();
-        for a in self.list(geometry, g.get(2), "associated geometry")? {
+            .or_else(|| self.part(geometry, "SEAM_CURVE"));
+        let (curve_id, associated) = match g {
+            Some(g) => (
+                self.reference(geometry, g.get(1), "3-D curve")?,
+                self.list(geometry, g.get(2), "associated geometry")?,
+            ),
+            None => (geometry, &[][..]),
+        };
+        let mut pcurves = Vec::new();
+        for a in associated {
             let pc = self.reference(geometry, Some(a), "associated geometry")?;
             let Some(p) = self.part(pc, "PCURVE") else {
                 continue;
@@ -661,20 +643,192 @@ impl<'a> Step<'a> {
                     )
                 })?;
             let items = self.list(rep, r.get(1), "items")?;
-            let curve = self.reference(rep, items.first(), "curve")?;
-            out.push(self.param_curve(curve)?);
+            pcurves.push(self.reference(rep, items.first(), "curve")?);
         }
-        if out.is_empty() {
-            return Err(self.fail(
-                geometry,
-                format!("no PCURVE on the face's surface #{surface}"),
-            ));
+        if pcurves.is_empty() {
+            return match analytic {
+                Some(Analytic::Plane(frame)) => {
+                    let curve = self.curve(curve_id, geometry)?;
+                    let range = self.edge_range(edge, &curve)?;
+                    let c = curve.nurbs(range).map_err(|x| self.fail(curve_id, super::strip(x)))?;
+                    Ok(vec![on_plane(&c, frame)])
+                }
+                _ => Err(self.fail(
+                    geometry,
+                    format!("no PCURVE on the face's surface #{surface} (an edge without \
+                             one is read on planes only)"),
+                )),
+            };
+        }
+        let mut out = Vec::new();
+        for pc in pcurves {
+            // On a B-spline surface, B-spline and polyline pcurves are whole (as written
+            // for B-spline faces); on an analytic one every pcurve is bounded by the edge.
+            let bounded = ["LINE", "CIRCLE", "ELLIPSE"]
+                .iter()
+                .any(|k| self.part(pc, k).is_some())
+                || (analytic.is_some() && self.part(pc, "B_SPLINE_CURVE_WITH_KNOTS").is_some());
+            if !bounded {
+                out.push(self.param_curve(pc)?);
+                continue;
+            }
+            let curve = self.curve(curve_id, geometry)?;
+            let range = self.edge_range(edge, &curve)?;
+            let plane = self.curve(pc, geometry)?;
+            let ranges = self.same_parameter_range(pc, &plane, &curve, range, analytic)?;
+            let mut segments = Vec::new();
+            for range in &ranges {
+                let c = plane.nurbs(*range).map_err(|x| self.fail(pc, super::strip(x)))?;
+                segments.extend(segments_2d(&c));
+            }
+            let range = ranges[0];
+            out.push(segments.clone());
+            if curve.periodic() && self.part(pc, "LINE").is_some() {
+                // A turn of the 3-D curve's parameter moves along the line by a period of
+                // the surface: which one the loop needs, its chaining decides.
+                let turn = plane.point(range[0] + std::f64::consts::TAU) - plane.point(range[0]);
+                for k in [-1.0, 1.0] {
+                    out.push(segments.iter().map(|s| s.shifted(k * turn.x, k * turn.y)).collect());
+                }
+            }
         }
         Ok(out)
     }
 
+    /// The parameter range of an edge on its 3-D curve: from the vertex it starts at to
+    /// the one it ends at, swapped if the edge runs against the curve (`same_sense` false);
+    /// on a circle or ellipse the increasing sweep between them (a whole turn if they
+    /// coincide), starting in `[0, 2 pi)`.
+    fn edge_range(&self, edge: usize, curve: &Curve) -> Result<[f64; 2]> {
+        let e = self.part(edge, "EDGE_CURVE").unwrap_or(&[]);
+        let vertex = |k: usize| -> Result<Vec3> {
+            let v = self.reference(edge, e.get(k), "vertex")?;
+            let p = self.part(v, "VERTEX_POINT").ok_or_else(|| {
+                self.fail(edge, format!("its vertex #{v} is not a VERTEX_POINT"))
+            })?;
+            self.vec3(self.reference(v, p.get(1), "vertex geometry")?, v)
+        };
+        let (start, end) = (vertex(1)?, vertex(2)?);
+        let (a, b) = if self.boolean(edge, e.get(4), "same_sense")? {
+            (start, end)
+        } else {
+            (end, start)
+        };
+        let (t0, t1) = (curve.parameter(a), curve.parameter(b));
+        if curve.periodic() {
+            let mut sweep = (t1 - t0).rem_euclid(std::f64::consts::TAU);
+            if sweep < 1e-12 || (a - b).norm() < 1e-9 * (1.0 + a.norm()) {
+                sweep = std::f64::consts::TAU;
+            }
+            return Ok([t0, t0 + sweep]);
+        }
+        if (t1 - t0).abs() < 1e-300 {
+            return Err(self.fail(edge, "an edge of zero length on its curve".into()));
+        }
+        Ok([t0.min(t1), t0.max(t1)])
+    }
+
+    /// The edge's range on its pcurve. The 3-D range first (OpenCascade's edges share
+    /// the parameter), each end then moved to where the pcurve's point on the analytic
+    /// surface is the 3-D curve's end point, by Gauss-Newton on `|S(p(t)) - C(t_end)|^2`
+    /// (derivative by central differences): a writer may reparametrise the surface but
+    /// not its lines (OpenCascade's cones). Errs naming the pcurve if an end is not
+    /// reached to `1e-6` of the size (the file's digits) or the middle of the pcurve's
+    /// range is off the 3-D curve.
+    fn same_parameter_range(
+        &self,
+        pc: usize,
+        plane: &Curve,
+        curve: &Curve,
+        range: [f64; 2],
+        analytic: Option<&Analytic>,
+    ) -> Result<Vec<[f64; 2]>> {
+        let Some(s) = analytic else {
+            return Ok(vec![range]);
+        };
+        let on = |t: f64| {
+            let uv = plane.point(t);
+            s.point(uv.x, uv.y)
+        };
+        let fail = || {
+            self.fail(
+                pc,
+                "this pcurve does not run along its edge's 3-D curve on the face's surface"
+                    .into(),
+            )
+        };
+        // The pcurve's parameter where its point on the surface is `want`, from `guess`.
+        // A B-spline pcurve (maybe closed, maybe in its own parameter) starts from the
+        // nearest of 512 samples of its range, the others from the 3-D parameter.
+        let spline = match plane {
+            Curve::Spline(c) => Some(c.range),
+            _ => None,
+        };
+        let solve = |guess: f64, want: Vec3| -> Result<f64> {
+            let guess = match spline {
+                Some([lo, hi]) => (0..=512)
+                    .map(|k| lo + (hi - lo) * k as f64 / 512.0)
+                    .min_by(|x, y| (on(*x) - want).norm().total_cmp(&(on(*y) - want).norm()))
+                    .unwrap_or(guess),
+                None => guess,
+            };
+            let (mut t, h) = (guess, 1e-6 * (1.0 + guess.abs()));
+            for _ in 0..50 {
+                let tangent = (on(t + h) - on(t - h)) / (2.0 * h);
+                let step = (on(t) - want).dot(&tangent) / tangent.norm_squared().max(1e-300);
+                t -= step;
+                if step.abs() <= 1e-15 * (1.0 + t.abs()) {
+                    break;
+                }
+            }
+            if let Some([lo, hi]) = spline {
+                t = t.clamp(lo, hi);
+            }
+            if (on(t) - want).norm() <= 1e-6 * (1.0 + want.norm()) {
+                Ok(t)
+            } else {
+                Err(fail())
+            }
+        };
+        let [a, b] = range;
+        let (ta, tb) = (solve(a, curve.point(a))?, solve(b, curve.point(b))?);
+        if let Some([lo, hi]) = spline {
+            // Between the ends, or, on a closed spline, round through its own ends.
+            let (t0, t1) = (ta.min(tb), ta.max(tb));
+            let tm = solve(0.5 * (t0 + t1), curve.point(0.5 * (a + b)))?;
+            return Ok(if tm >= t0 && tm <= t1 {
+                vec![[t0, t1]]
+            } else {
+                [[t1, hi], [lo, t0]].into_iter().filter(|r| r[1] > r[0]).collect()
+            });
+        }
+        if !plane.periodic() {
+            return Ok(vec![[ta.min(tb), ta.max(tb)]]);
+        }
+        // A circle or ellipse of the parameter plane runs counter-clockwise, which may be
+        // against the edge: take the arc between the ends that holds the edge's middle.
+        let tau = std::f64::consts::TAU;
+        let closed = (b - a - tau).abs() < 1e-9 * (1.0 + b.abs());
+        let sweep = (tb - ta).rem_euclid(tau);
+        if closed || sweep < 1e-12 {
+            return Ok(vec![[ta, ta + tau]]);
+        }
+        let tm = solve(0.5 * (ta + tb), curve.point(0.5 * (a + b)))?;
+        let out = if (tm - ta).rem_euclid(tau) < sweep {
+            [ta, ta + sweep]
+        } else {
+            [tb, tb + (ta - tb).rem_euclid(tau)]
+        };
+        Ok(vec![out])
+    }
+
     /// A loop's segments, edges chained by continuity.
-    fn boundary(&self, bound: usize, surface: usize) -> Result<Vec<TrimSegment>> {
+    fn boundary(
+        &self,
+        bound: usize,
+        surface: usize,
+        analytic: Option<&Analytic>,
+    ) -> Result<Vec<TrimSegment>> {
         let b = self
             .part(bound, "FACE_OUTER_BOUND")
             .or_else(|| self.part(bound, "FACE_BOUND"))
@@ -692,32 +846,33 @@ impl<'a> Step<'a> {
             let edge = self.reference(oe, o.get(3), "edge element")?;
             // Every pcurve on this surface, both ways (a seam edge has two).
             let mut options = Vec::new();
-            for c in self.edge_pcurves(edge, surface)? {
+            for c in self.edge_pcurves(edge, surface, analytic)? {
                 let reversed: Vec<TrimSegment> = c.iter().rev().map(|s| s.reversed()).collect();
                 options.push(c);
                 options.push(reversed);
             }
             edges.push(options);
         }
-        let gap = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
-        let mut out: Vec<TrimSegment> = Vec::new();
-        for k in 0..edges.len() {
-            // The option starting where the chain ends; the first edge's, the one ending
-            // nearest to an end of the next edge.
-            let score = |option: &Vec<TrimSegment>| match out.last() {
-                Some(last) => gap(last.end(), option[0].start()),
-                None => edges[(k + 1) % edges.len()]
-                    .iter()
-                    .map(|next| gap(option.last().unwrap().end(), next[0].start()))
-                    .fold(f64::INFINITY, f64::min),
-            };
-            let best = edges[k]
-                .iter()
-                .min_by(|a, b| score(a).total_cmp(&score(b)))
-                .unwrap();
-            out.extend(best.iter().cloned());
+        Ok(chain(&edges))
+    }
+
+    /// The trimming loops of face `id` on `surface` (vertex loops bound nothing).
+    fn loops(
+        &self,
+        id: usize,
+        surface: usize,
+        analytic: Option<&Analytic>,
+    ) -> Result<Vec<Vec<TrimSegment>>> {
+        let p = self.part(id, "ADVANCED_FACE").unwrap_or(&[]);
+        let mut loops = Vec::new();
+        for b in self.list(id, p.get(1), "bounds")? {
+            let b = self.reference(id, Some(b), "bound")?;
+            let segments = self.boundary(b, surface, analytic)?;
+            if !segments.is_empty() {
+                loops.push(segments);
+            }
         }
-        Ok(out)
+        Ok(loops)
     }
 
     fn faces(&self) -> Result<Vec<Face>> {
@@ -728,17 +883,23 @@ impl<'a> Step<'a> {
                 continue;
             };
             let surface_id = self.reference(id, p.get(2), "face geometry")?;
-            self.instance(surface_id, id, "surface")?;
-            let surface = self.surface(surface_id, id)?;
+            let analytic = self.analytic(surface_id, id)?;
             let same_sense = self.boolean(id, p.get(3), "same_sense")?;
-            let mut loops = Vec::new();
-            for b in self.list(id, p.get(1), "bounds")? {
-                let b = self.reference(id, Some(b), "bound")?;
-                let segments = self.boundary(b, surface_id)?;
-                if !segments.is_empty() {
-                    loops.push(segments);
-                }
-            }
+            let (analytic, loops) = match self.loops(id, surface_id, analytic.as_ref()) {
+                Ok(loops) => (analytic, loops),
+                // A cone whose pcurves run by OpenCascade's slant length.
+                Err(e) => match analytic.as_ref().and_then(Analytic::slanted) {
+                    Some(slanted) => match self.loops(id, surface_id, Some(&slanted)) {
+                        Ok(loops) => (Some(slanted), loops),
+                        Err(_) => return Err(e),
+                    },
+                    None => return Err(e),
+                },
+            };
+            let (surface, arcs) = match &analytic {
+                None => (self.surface(surface_id, id)?, [None, None]),
+                Some(a) => self.analytic_face(a, id, &loops)?,
+            };
             let trim = if loops.is_empty() {
                 None
             } else {
@@ -752,7 +913,7 @@ impl<'a> Step<'a> {
                     trim: trim.clone(),
                     origin: format!("#{id} (ADVANCED_FACE) at line {}", inst.line),
                     flip: !same_sense,
-                    arcs: [None, None],
+                    arcs,
                 });
             }
         }
@@ -764,6 +925,126 @@ impl<'a> Step<'a> {
         }
         Ok(faces)
     }
+}
+
+impl Step<'_> {
+    /// The exact NURBS of an analytic face over the box of its loops, in mm, with its arc
+    /// half angles (see [`super::step_analytic`]).
+    fn analytic_face(
+        &self,
+        a: &Analytic,
+        face: usize,
+        loops: &[Vec<TrimSegment>],
+    ) -> Result<(NurbsSurface, [Option<f64>; 2])> {
+        let boxed = loops.iter().flatten().map(|s| s.hull_box()).reduce(|a, b| {
+            [0, 1].map(|d| [a[d][0].min(b[d][0]), a[d][1].max(b[d][1])])
+        });
+        let extent = a.extent(boxed).ok_or_else(|| {
+            self.fail(face, "a face on an unbounded surface with no bounding loop".into())
+        })?;
+        let (s, arcs) = a.nurbs(extent).map_err(|e| self.fail(face, super::strip(e)))?;
+        let scale = crate::geometry::Mat3::identity() * self.to_mm;
+        Ok((s.transformed(&scale, &Vec3::zeros()), arcs))
+    }
+}
+
+/// The loop of one option per edge (each option an edge's segments one way, on one
+/// turn of a periodic surface): a depth-first search for options that meet end to start
+/// within `1e-9` of the loop's size and close the loop; a loop of one option per edge
+/// has at most 6 options an edge and continuity prunes all but one or two, so the search
+/// is short (capped at 10^5 steps). Without such a chain, the greedy one (each option
+/// the nearest to the previous end), whose gap the trim region then reports.
+fn chain(edges: &[Vec<Vec<TrimSegment>>]) -> Vec<TrimSegment> {
+    let gap = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let size = edges
+        .iter()
+        .flatten()
+        .flatten()
+        .flat_map(|s| [s.start(), s.end()])
+        .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+    let tol = 1e-9 * (1.0 + size);
+    let mut picks = vec![0usize; edges.len()];
+    let mut steps = 0usize;
+    fn search(
+        edges: &[Vec<Vec<TrimSegment>>],
+        k: usize,
+        picks: &mut Vec<usize>,
+        steps: &mut usize,
+        ok: &dyn Fn([f64; 2], [f64; 2]) -> bool,
+    ) -> bool {
+        if k == edges.len() {
+            let first = edges[0][picks[0]][0].start();
+            let last = edges[k - 1][picks[k - 1]].last().unwrap().end();
+            return ok(last, first);
+        }
+        for (i, option) in edges[k].iter().enumerate() {
+            *steps += 1;
+            if *steps > 100_000 {
+                return false;
+            }
+            if k > 0 && !ok(edges[k - 1][picks[k - 1]].last().unwrap().end(), option[0].start()) {
+                continue;
+            }
+            picks[k] = i;
+            if search(edges, k + 1, picks, steps, ok) {
+                return true;
+            }
+        }
+        false
+    }
+    let ok = |a: [f64; 2], b: [f64; 2]| gap(a, b) <= tol;
+    if edges.is_empty() || search(edges, 0, &mut picks, &mut steps, &ok) {
+        return picks
+            .iter()
+            .enumerate()
+            .flat_map(|(k, &i)| edges[k][i].iter().cloned())
+            .collect();
+    }
+    let mut out: Vec<TrimSegment> = Vec::new();
+    for k in 0..edges.len() {
+        // The option starting where the chain ends; the first edge's, the one ending
+        // nearest to an end of the next edge.
+        let score = |option: &Vec<TrimSegment>| match out.last() {
+            Some(last) => gap(last.end(), option[0].start()),
+            None => edges[(k + 1) % edges.len()]
+                .iter()
+                .map(|next| gap(option.last().unwrap().end(), next[0].start()))
+                .fold(f64::INFINITY, f64::min),
+        };
+        let best = edges[k]
+            .iter()
+            .min_by(|a, b| score(a).total_cmp(&score(b)))
+            .unwrap();
+        out.extend(best.iter().cloned());
+    }
+    out
+}
+
+/// A curve of the parameter plane (its `z` is 0) as trimming segments.
+fn segments_2d(c: &NurbsCurve) -> Vec<TrimSegment> {
+    c.segments()
+        .into_iter()
+        .map(|h| TrimSegment::new(h.iter().map(|q| [q[0], q[1], q[3]]).collect()))
+        .collect()
+}
+
+/// A space curve lying on a plane as trimming segments in the plane's `(u, v)`: the map
+/// `x -> ((x - c) . x_axis, (x - c) . y_axis)` is affine, so it acts exactly on the
+/// homogeneous control points.
+fn on_plane(c: &NurbsCurve, f: &Frame) -> Vec<TrimSegment> {
+    c.segments()
+        .into_iter()
+        .map(|h| {
+            let pts = h
+                .iter()
+                .map(|q| {
+                    let d = Vec3::new(q[0], q[1], q[2]) - f.origin * q[3];
+                    [d.dot(&f.x), d.dot(&f.y), q[3]]
+                })
+                .collect();
+            TrimSegment::new(pts)
+        })
+        .collect()
 }
 
 #[cfg(test)]

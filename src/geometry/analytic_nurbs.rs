@@ -120,6 +120,19 @@ impl NurbsCurve {
         }
     }
 
+    /// The segment `origin + t direction` for `t` over `range` (increasing): a line in its
+    /// own parameter, as STEP's `LINE` runs.
+    pub fn ray(origin: Vec3, direction: Vec3, range: [f64; 2]) -> Result<NurbsCurve> {
+        let [a, b] = range;
+        NurbsCurve::new(
+            1,
+            vec![a, a, b, b],
+            vec![origin + direction * a, origin + direction * b],
+            vec![1.0, 1.0],
+            range,
+        )
+    }
+
     /// The arc `centre + r (cos t x + sin t y)`, `t` from `angles[0]` to `angles[1]`
     /// (greater); `x`, `y` orthonormal. The parameter is the angle at every breakpoint.
     pub fn arc(centre: Vec3, x: Vec3, y: Vec3, r: f64, angles: [f64; 2]) -> Result<NurbsCurve> {
@@ -248,19 +261,30 @@ pub fn revolution(
 
 /// The surface `C(u) + v d`, `v` in `[0, 1]`: a tabulated cylinder.
 pub fn extrusion(directrix: &NurbsCurve, direction: Vec3) -> Result<NurbsSurface> {
+    extrusion_over(directrix, direction, [0.0, 1.0])
+}
+
+/// The surface `C(u) + v d` for `v` over `range` (increasing): STEP's
+/// `SURFACE_OF_LINEAR_EXTRUSION`, in its own parameters.
+pub fn extrusion_over(
+    directrix: &NurbsCurve,
+    direction: Vec3,
+    range: [f64; 2],
+) -> Result<NurbsSurface> {
+    let [a, b] = range;
     let points = directrix
         .points
         .iter()
-        .map(|p| vec![*p, p + direction])
+        .map(|p| vec![p + direction * a, p + direction * b])
         .collect();
     let weights = directrix.weights.iter().map(|w| vec![*w, *w]).collect();
     NurbsSurface::new(
         [directrix.degree, 1],
-        [directrix.knots.clone(), vec![0.0, 0.0, 1.0, 1.0]],
+        [directrix.knots.clone(), vec![a, a, b, b]],
         points,
         Some(weights),
     )?
-    .restricted(directrix.range, [0.0, 1.0])
+    .restricted(directrix.range, range)
 }
 
 #[cfg(test)]

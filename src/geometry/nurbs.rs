@@ -280,6 +280,29 @@ impl NurbsSurface {
         self.domain
     }
 
+    /// The same surface with `u` and `v` exchanged: `T(u, v) = S(v, u)`. Exact (the control
+    /// net is transposed); the normal `T_u x T_v = -(S_u x S_v)` is reversed.
+    pub fn transposed(self) -> NurbsSurface {
+        let [nu, nv] = self.count;
+        let mut points = Vec::with_capacity(self.points.len());
+        let mut weights = Vec::with_capacity(self.weights.len());
+        for j in 0..nv {
+            for i in 0..nu {
+                points.push(self.points[i * nv + j]);
+                weights.push(self.weights[i * nv + j]);
+            }
+        }
+        let [ku, kv] = self.knots;
+        NurbsSurface {
+            degree: [self.degree[1], self.degree[0]],
+            knots: [kv, ku],
+            count: [nv, nu],
+            points,
+            weights,
+            domain: [self.domain[1], self.domain[0]],
+        }
+    }
+
     /// The surface moved rigidly (or scaled): every control point `x -> R x + t`.
     pub fn transformed(mut self, rotation: &Mat3, translation: &Vec3) -> NurbsSurface {
         for p in &mut self.points {

@@ -52,6 +52,29 @@ impl TrimSegment {
         TrimSegment { points }
     }
 
+    /// The box `[[u0, u1], [v0, v1]]` of the control points, which holds the segment
+    /// (convex hull property, weights > 0).
+    pub fn hull_box(&self) -> [[f64; 2]; 2] {
+        let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+        for h in &self.points {
+            let p = Self::euclidean(h);
+            for d in 0..2 {
+                b[d] = [b[d][0].min(p[d]), b[d][1].max(p[d])];
+            }
+        }
+        b
+    }
+
+    /// The segment moved by `(du, dv)` (exact on the homogeneous points).
+    pub fn shifted(&self, du: f64, dv: f64) -> TrimSegment {
+        let points = self
+            .points
+            .iter()
+            .map(|h| [h[0] + du * h[2], h[1] + dv * h[2], h[2]])
+            .collect();
+        TrimSegment { points }
+    }
+
     /// The same segment run backwards.
     pub fn reversed(&self) -> TrimSegment {
         TrimSegment::new(self.points.iter().rev().copied().collect())

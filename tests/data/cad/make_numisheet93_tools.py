@@ -16,9 +16,9 @@ model-space curves and 120 surfaces of revolution (line or arc generatrix) trimm
 their (t, angle) parameters. tribo reads those (`punch_analytic.igs`, `die_analytic.igs`)
 and, from both formats, rational B-spline surfaces, for which each solid is converted with
 BRepBuilderAPI_NurbsConvert (exact: circles and tori become rational quadratic B-splines)
-before the `*_nurbs.igs` / `*_nurbs.step` export. `punch_analytic.step` (STEP's PLANE,
-CYLINDRICAL_SURFACE, TOROIDAL_SURFACE, not read) checks that unread surfaces are refused
-with their type and index.
+before the `*_nurbs.igs` / `*_nurbs.step` export. `punch_analytic.step` and
+`die_analytic.step` are the solids as STEP writes them by default (PLANE,
+CYLINDRICAL_SURFACE, TOROIDAL_SURFACE), read as the exact NURBS they are.
 
 `punch_assembly.step` is an assembly (OCC's XCAF document, STEPCAFControl_Writer) holding
 the NURBS punch as a component placed by a rotation of 30 degrees about z then a
@@ -141,6 +141,7 @@ if __name__ == "__main__":
     write_iges(p, "punch_analytic.igs")
     write_step(p, "punch_analytic.step")
     write_iges(d, "die_analytic.igs")
+    write_step(d, "die_analytic.step")
     for name, shape in (("punch", p), ("die", d)):
         n = nurbs(shape)
         write_iges(n, f"{name}_nurbs.igs")
