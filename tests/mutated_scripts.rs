@@ -129,7 +129,12 @@ fn campaign_sample_of_shipped_script_mutants() {
         &bin,
         sample,
         2,
-        std::time::Duration::from_secs(60),
+        // A hang is a run that never ends. One sampled mutant (restart_drag.rhai with the
+        // roller's axis tilted, `[0, 1, 2.5]`) crawls at the minimum step and stops with
+        // its reason after 48-55 s of CPU on this machine, before and after issue 51: at
+        // 60 s, two such runs side by side on 2 loaded cores were reported as hangs.
+        // Stopping a crawl at a stated floor is issue 52's; until then, 150 s.
+        std::time::Duration::from_secs(150),
         &base,
         None,
     );
