@@ -135,7 +135,11 @@ fn punch_equals_the_builder(format: &str) {
     // The punch's corner blends are spindle tori (major 2, minor 8), which OpenCascade's
     // STEP writer puts as a SURFACE_OF_REVOLUTION of a polynomial degree-6 B-spline that
     // approximates the profile arc to ~1.2e-7 mm: read exactly, it is the file's surface.
-    let tol = if format == "step-analytic" { 1e-6 } else { 1e-8 };
+    let tol = if format == "step-analytic" {
+        1e-6
+    } else {
+        1e-8
+    };
     let worst = worst_difference_within(&imported, &reference, &points, tol);
     eprintln!("punch ({format}): worst foot, normal, gap differences {worst:?}");
     let seams = imported.seams();
@@ -417,8 +421,15 @@ fn bad_step_files_are_refused_naming_what_and_where() {
     );
     // A surface kind that is not read, named with the kinds that are.
     let (_, analytic) = data("punch_analytic.step");
-    let face_line = 1 + analytic.lines().position(|l| l.starts_with("#17 = ADVANCED_FACE(")).unwrap();
-    let unread = analytic.replacen("#32 = PLANE('',#33);", "#32 = CURVE_BOUNDED_SURFACE('',#33);", 1);
+    let face_line = 1 + analytic
+        .lines()
+        .position(|l| l.starts_with("#17 = ADVANCED_FACE("))
+        .unwrap();
+    let unread = analytic.replacen(
+        "#32 = PLANE('',#33);",
+        "#32 = CURVE_BOUNDED_SURFACE('',#33);",
+        1,
+    );
     let e = step_refusal("punch_analytic.step", &unread);
     assert!(
         e.contains(&format!("punch_analytic.step:{}: #17 (ADVANCED_FACE): its surface #32 is a CURVE_BOUNDED_SURFACE, which is not read (read: PLANE, CYLINDRICAL_SURFACE", face_line)),

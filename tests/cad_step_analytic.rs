@@ -29,7 +29,12 @@ fn frame() -> Frame {
     let z = Vec3::new(0.2, -0.3, 1.0).normalize();
     let v = Vec3::new(1.0, 0.1, 0.04);
     let x = (v - z * v.dot(&z)).normalize();
-    Frame { o: Vec3::new(1.0, 2.0, 3.0), x, y: z.cross(&x), z }
+    Frame {
+        o: Vec3::new(1.0, 2.0, 3.0),
+        x,
+        y: z.cross(&x),
+        z,
+    }
 }
 
 /// Distance of `p` to the exact surface and the surface's documented normal there.
@@ -68,7 +73,10 @@ fn exact(kind: &str) -> Exact {
         "cone" => Box::new(move |p| {
             let (h, rho, e) = cylindrical(&f, p);
             let a: f64 = 0.4;
-            ((rho - 3.0 - h * a.tan()) * a.cos(), e * a.cos() - f.z * a.sin())
+            (
+                (rho - 3.0 - h * a.tan()) * a.cos(),
+                e * a.cos() - f.z * a.sin(),
+            )
         }),
         "sphere" => Box::new(move |p| ((p - f.o).norm() - 5.0, (p - f.o).normalize())),
         "torus" => tube(5.0, 2.0),
@@ -144,7 +152,9 @@ fn each_analytic_kind_is_its_exact_surface_with_the_documented_normal() {
                 worst_normal = worst_normal.max((face_normal(face, a, b) - normal).norm());
             }
         }
-        eprintln!("{kind}: domain {u:?} x {v:?}, worst distance {worst:.1e}, normal {worst_normal:.1e}");
+        eprintln!(
+            "{kind}: domain {u:?} x {v:?}, worst distance {worst:.1e}, normal {worst_normal:.1e}"
+        );
         // OpenCascade writes the spindle torus as a SURFACE_OF_REVOLUTION of a polynomial
         // degree-6 B-spline approximating the profile circle to ~1e-7 (its own
         // approximation; the revolution itself is exact, as "revolution" shows at 1e-9).
@@ -210,11 +220,20 @@ fn the_plane_face_has_its_hole() {
                 none_above_hole += 1;
             }
             Some(p) => {
-                assert!((p.foot - f.o).dot(&f.z).abs() < 1e-9, "foot off the plane: {p:?}");
+                assert!(
+                    (p.foot - f.o).dot(&f.z).abs() < 1e-9,
+                    "foot off the plane: {p:?}"
+                );
                 let from_centre = (p.foot - centre).norm();
-                assert!(from_centre > 1.5 - 1e-9, "foot inside the hole at {from_centre}");
+                assert!(
+                    from_centre > 1.5 - 1e-9,
+                    "foot inside the hole at {from_centre}"
+                );
                 if rho > 1.5 + 1e-9 {
-                    assert!((p.gap - 0.3).abs() < 1e-9 && (p.normal - f.z).norm() < 1e-12, "{p:?}");
+                    assert!(
+                        (p.gap - 0.3).abs() < 1e-9 && (p.normal - f.z).norm() < 1e-12,
+                        "{p:?}"
+                    );
                 }
             }
         }

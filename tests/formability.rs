@@ -67,9 +67,13 @@ fn imported_one_layer_blank_runs_with_the_solid_shell() {
     model.settings.kinematics = StrainTheory::Finite;
     model.settings.increments = 2;
     for (set, c) in [("x-", "x"), ("y-", "y")] {
-        model.prescribe(set, c, ScalarSchedule::constant(0.0)).unwrap();
+        model
+            .prescribe(set, c, ScalarSchedule::constant(0.0))
+            .unwrap();
     }
-    model.prescribe("origin", "z", ScalarSchedule::constant(0.0)).unwrap();
+    model
+        .prescribe("origin", "z", ScalarSchedule::constant(0.0))
+        .unwrap();
     let ramp = ScalarSchedule::new(vec![(0.0, 0.0), (1.0, 7.5)]).unwrap();
     model.prescribe("x+", "x", ramp).unwrap();
     let mut sim = Simulation::new(model).unwrap();
@@ -89,8 +93,18 @@ fn imported_one_layer_blank_runs_with_the_solid_shell() {
     // A homogeneous uniaxial stretch: the imposed log strain at every node, to the
     // Newton tolerance's effect on the positions (1e-6 of the 7.5 travel, well above it).
     let major = field(&frame, "major_strain");
-    assert!(major.iter().all(|&e| (e - 0.1_f64.ln_1p()).abs() < 1e-6), "{:?}", &major[..4]);
-    for name in ["thinning", "minor_strain", "strain_ratio", "flc_margin", "formability"] {
+    assert!(
+        major.iter().all(|&e| (e - 0.1_f64.ln_1p()).abs() < 1e-6),
+        "{:?}",
+        &major[..4]
+    );
+    for name in [
+        "thinning",
+        "minor_strain",
+        "strain_ratio",
+        "flc_margin",
+        "formability",
+    ] {
         field(&frame, name);
     }
 }
@@ -106,20 +120,29 @@ enum Path {
 
 /// A 2 x 2 x 1 sheet (1 x 1 x 0.2) of `material` stretched along `path` to the log strain
 /// `strain` in `increments` (finite strain, F-bar); the frames after each increment.
-fn stretch(material: ElastoPlastic, path: Path, strain: f64, increments: usize) -> Vec<(Frame, Vec<f64>)> {
+fn stretch(
+    material: ElastoPlastic,
+    path: Path,
+    strain: f64,
+    increments: usize,
+) -> Vec<(Frame, Vec<f64>)> {
     let mesh = Mesh::block(Vec3::zeros(), Vec3::new(1.0, 1.0, 0.2), [2, 2, 1]).unwrap();
     let mut model = Model::new(mesh, Arc::new(material)).unwrap();
     model.settings.kinematics = StrainTheory::Finite;
     model.settings.increments = increments;
     model.settings.force_rel_tol = 1e-12;
     for (set, c) in [("x-", "x"), ("y-", "y"), ("z-", "z")] {
-        model.prescribe(set, c, ScalarSchedule::constant(0.0)).unwrap();
+        model
+            .prescribe(set, c, ScalarSchedule::constant(0.0))
+            .unwrap();
     }
     let ramp = ScalarSchedule::new(vec![(0.0, 0.0), (1.0, strain.exp_m1())]).unwrap();
     model.prescribe("x+", "x", ramp.clone()).unwrap();
     match path {
         Path::Uniaxial => {}
-        Path::PlaneStrain => model.prescribe("y+", "y", ScalarSchedule::constant(0.0)).unwrap(),
+        Path::PlaneStrain => model
+            .prescribe("y+", "y", ScalarSchedule::constant(0.0))
+            .unwrap(),
         Path::Equibiaxial => model.prescribe("y+", "y", ramp).unwrap(),
     }
     let mut sim = Simulation::new(model).unwrap();
@@ -171,10 +194,22 @@ fn homogeneous_stretching_gives_the_logs_of_the_stretches() {
             let ratio = field(frame, "strain_ratio");
             for n in 0..major.len() {
                 let at = format!("{r:?} {path:?} node {n}");
-                assert!((major[n] - e1).abs() < 1e-8, "{at}: major {} against {e1}", major[n]);
-                assert!((minor[n] - e2).abs() < 1e-8, "{at}: minor {} against {e2}", minor[n]);
+                assert!(
+                    (major[n] - e1).abs() < 1e-8,
+                    "{at}: major {} against {e1}",
+                    major[n]
+                );
+                assert!(
+                    (minor[n] - e2).abs() < 1e-8,
+                    "{at}: minor {} against {e2}",
+                    minor[n]
+                );
                 let want = 100.0 * (1.0 - t / t0);
-                assert!((thinning[n] - want).abs() < 1e-8, "{at}: thinning {} against {want}", thinning[n]);
+                assert!(
+                    (thinning[n] - want).abs() < 1e-8,
+                    "{at}: thinning {} against {want}",
+                    thinning[n]
+                );
                 assert!((ratio[n] - e2 / e1).abs() < 1e-8, "{at}");
             }
         }
@@ -219,7 +254,9 @@ fn plane_strain_beyond_the_curve_is_a_crack() {
         assert_eq!(zone[n], Zone::Crack.code() as f64);
     }
     let first = field(&frames[0].0, "formability");
-    assert!(first.iter().all(|&z| z == Zone::RiskOfCrack.code() as f64 || z == Zone::Safe.code() as f64));
+    assert!(first
+        .iter()
+        .all(|&z| z == Zone::RiskOfCrack.code() as f64 || z == Zone::Safe.code() as f64));
     let _ = FormabilityOptions::default();
 }
 
@@ -257,12 +294,15 @@ sim.chart_field("thinning.svg", "z+", "thinning");
     };
     tribo::script::run_file(&script, &[], &host).unwrap();
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
     let f = &summary["formability"];
     // Plane strain to ln(1.2) = 0.18 > 0.15: every column beyond the table's curve.
     assert_eq!(f["worst_zone"], "crack", "{f}");
     assert_eq!(f["nodes_per_zone"]["crack"], 50, "{f}");
-    let total: u64 = (f["nodes_per_zone"].as_object().unwrap().values()).map(|v| v.as_u64().unwrap()).sum();
+    let total: u64 = (f["nodes_per_zone"].as_object().unwrap().values())
+        .map(|v| v.as_u64().unwrap())
+        .sum();
     assert_eq!(total, 50);
     assert_eq!(f["flc"]["kind"], "table");
     let margin = f["min_flc_margin"].as_f64().unwrap();
@@ -271,7 +311,9 @@ sim.chart_field("thinning.svg", "z+", "thinning");
     assert!(thinning > 10.0 && thinning < 20.0, "{thinning}");
     assert!(f["max_thinning_at"]["node"].is_u64());
     for chart in ["fld.svg", "fld.csv", "thinning.svg", "thinning.csv"] {
-        let size = std::fs::metadata(dir.join("out").join(chart)).unwrap().len();
+        let size = std::fs::metadata(dir.join("out").join(chart))
+            .unwrap()
+            .len();
         assert!(size > 0 && size < 200_000, "{chart}: {size} bytes");
     }
     let _ = std::fs::remove_dir_all(&dir);

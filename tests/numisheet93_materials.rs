@@ -16,10 +16,10 @@
 //! converged plastic state, hence the 1e-6 relative tolerance (the driver converges the
 //! stress to 1e-10 relative).
 
-use nalgebra::{SMatrix, SVector};
 use rhai::{Dynamic, Map};
 use tribo::material::{
-    ElastoPlastic, Hardening, Hill48, Kinematics, LinearElastic, Material, PointState, Voigt,
+    uniaxial_direction, uniaxial_stress_path, ElastoPlastic, Hardening, Hill48, LinearElastic,
+    PointState,
 };
 use tribo::script::{engine, HostOptions};
 
@@ -100,7 +100,12 @@ fn steel(angle: f64) -> ElastoPlastic {
             .unwrap()
             .with_rolling_angle(angle)
             .unwrap(),
-        Hardening::swift(get(&m, "swift_c"), get(&m, "swift_eps0"), get(&m, "swift_n")).unwrap(),
+        Hardening::swift(
+            get(&m, "swift_c"),
+            get(&m, "swift_eps0"),
+            get(&m, "swift_n"),
+        )
+        .unwrap(),
     )
 }
 
@@ -108,39 +113,10 @@ fn steel(angle: f64) -> ElastoPlastic {
 /// step Newton with the material's consistent tangent solves `σ(ε) = s e_x`, `εxx = target`
 /// for `(ε, s)`, every other stress component zero. The committed state after every step.
 fn uniaxial_x(m: &ElastoPlastic, eps_max: f64, steps: usize) -> Vec<PointState> {
-    let q = Voigt::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    let mut committed = m.initial_state();
-    let mut states = Vec::new();
-    for k in 1..=steps {
-        let target = eps_max * k as f64 / steps as f64;
-        let (mut eps, mut s, mut trial) = (committed.strain, committed.stress[0], committed);
-        let mut converged = false;
-        for _ in 0..40 {
-            let d = m
-                .update(&Kinematics::from_strain(eps), &committed, &mut trial)
-                .unwrap();
-            let r_sig = trial.stress - q * s;
-            let r_eps = eps[0] - target;
-            if r_sig.amax() <= 1e-10 * s.abs().max(1.0) && r_eps.abs() < 1e-15 {
-                converged = true;
-                break;
-            }
-            let mut jac = SMatrix::<f64, 7, 7>::zeros();
-            jac.fixed_view_mut::<6, 6>(0, 0).copy_from(&d);
-            jac.fixed_view_mut::<6, 1>(0, 6).copy_from(&(-q));
-            jac.fixed_view_mut::<1, 6>(6, 0).copy_from(&q.transpose());
-            let rhs = -SVector::<f64, 7>::from_iterator(
-                r_sig.iter().copied().chain(std::iter::once(r_eps)),
-            );
-            let dx = jac.lu().solve(&rhs).unwrap();
-            eps += dx.fixed_rows::<6>(0);
-            s += dx[6];
-        }
-        assert!(converged, "uniaxial driver, step {k}");
-        committed = trial;
-        states.push(committed);
-    }
-    states
+    let targets: Vec<f64> = (1..=steps)
+        .map(|k| eps_max * k as f64 / steps as f64)
+        .collect();
+    uniaxial_stress_path(m, uniaxial_direction(0.0), &targets).unwrap()
 }
 
 #[test]
@@ -157,7 +133,9 @@ fn steel_tension_at_0_45_90_degrees_gives_the_specified_r_values_and_yield_stres
         let m = steel(-theta);
         let states = uniaxial_x(&m, 0.05, 25);
         let (s, co) = theta.sin_cos();
-        let k = f * s.powi(4) + g * co.powi(4) + h * (co * co - s * s).powi(2)
+        let k = f * s.powi(4)
+            + g * co.powi(4)
+            + h * (co * co - s * s).powi(2)
             + 2.0 * nn * co * co * s * s;
         let mut plastic = 0;
         for (a, b) in states.iter().zip(&states[1..]) {

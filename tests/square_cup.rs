@@ -102,12 +102,22 @@ fn the_default_element_of_a_one_layer_cup_is_the_solid_shell() {
         (vec!["layers=2"], "hexahedron"),
         (vec!["element=\"hexahedron\""], "hexahedron"),
     ] {
-        let out = out_dir(&format!("default_element_{}", sets.len() * 10 + expect.len()));
+        let out = out_dir(&format!(
+            "default_element_{}",
+            sets.len() * 10 + expect.len()
+        ));
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_tribo"));
         cmd.current_dir(root)
             .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
             .arg(&out)
-            .args(["--set", "cells=4", "--set", "travel=1.0", "--set", "charts=false"]);
+            .args([
+                "--set",
+                "cells=4",
+                "--set",
+                "travel=1.0",
+                "--set",
+                "charts=false",
+            ]);
         for s in &sets {
             cmd.args(["--set", s]);
         }
@@ -130,9 +140,19 @@ fn the_default_element_of_a_one_layer_cup_is_the_solid_shell() {
 /// von Mises steel on the same mesh is symmetric again (< 1e-6).
 #[test]
 fn benchmark_cup_of_the_mild_steel_runs_to_its_checks() {
-    let base = ["cells=8", "travel=3.0", "charts=false", "variant=\"benchmark\"", "material=\"steel\""];
+    let base = [
+        "cells=8",
+        "travel=3.0",
+        "charts=false",
+        "variant=\"benchmark\"",
+        "material=\"steel\"",
+    ];
     let out = out_dir("steel_hill48");
-    let sets: Vec<&str> = base.iter().copied().chain(["yield_kind=\"hill48\""]).collect();
+    let sets: Vec<&str> = base
+        .iter()
+        .copied()
+        .chain(["yield_kind=\"hill48\""])
+        .collect();
     let summary = run_cup_with(&out, &sets);
     let checks = &summary["checks"];
     assert_eq!(summary["status"], "finished", "{summary}");
@@ -146,14 +166,24 @@ fn benchmark_cup_of_the_mild_steel_runs_to_its_checks() {
     let holder = summary["tools"]["blankholder"]["final_force"][2]
         .as_f64()
         .expect("blankholder force");
-    assert!((holder - 4900.0).abs() < 1e-6 * 4900.0, "quarter holder force {holder}");
+    assert!(
+        (holder - 4900.0).abs() < 1e-6 * 4900.0,
+        "quarter holder force {holder}"
+    );
     // The blank is the steel's 0.78 mm: the punch-side contact points sit at z = 0.78.
     let at = &summary["frictional_work_peaks"]["punch"]["at"][2];
-    assert!((at.as_f64().expect("peak position") - 0.78).abs() < 1e-12, "{at}");
+    assert!(
+        (at.as_f64().expect("peak position") - 0.78).abs() < 1e-12,
+        "{at}"
+    );
     let _ = std::fs::remove_dir_all(&out);
 
     let out = out_dir("steel_von_mises");
-    let sets: Vec<&str> = base.iter().copied().chain(["yield_kind=\"isotropic\""]).collect();
+    let sets: Vec<&str> = base
+        .iter()
+        .copied()
+        .chain(["yield_kind=\"isotropic\""])
+        .collect();
     let summary = run_cup_with(&out, &sets);
     let checks = &summary["checks"];
     assert_eq!(checks["diagonal_symmetric_material"], true, "{checks}");

@@ -468,7 +468,12 @@ impl<'a> Step<'a> {
     }
 
     /// Knots expanded from `(multiplicities)` and `(values)`.
-    pub(super) fn knots(&self, id: usize, mults: Option<&Value>, values: Option<&Value>) -> Result<Vec<f64>> {
+    pub(super) fn knots(
+        &self,
+        id: usize,
+        mults: Option<&Value>,
+        values: Option<&Value>,
+    ) -> Result<Vec<f64>> {
         let m = self.list(id, mults, "knot multiplicities")?;
         let k = self.list(id, values, "knot values")?;
         if m.len() != k.len() {
@@ -585,11 +590,14 @@ impl<'a> Step<'a> {
                 .collect());
         }
         if self.part(id, "B_SPLINE_CURVE_WITH_KNOTS").is_none() {
-            return Err(self.fail(id, format!(
-                "a {} as a parameter-space trimming curve is not read (read: B-spline curves, \
+            return Err(self.fail(
+                id,
+                format!(
+                    "a {} as a parameter-space trimming curve is not read (read: B-spline curves, \
                  polylines, and lines, circles, ellipses bounded by the edge's vertices)",
-                self.kind(id)
-            )));
+                    self.kind(id)
+                ),
+            ));
         }
         Ok(segments_2d(&self.spline_curve(id)?))
     }
@@ -650,13 +658,17 @@ impl<'a> Step<'a> {
                 Some(Analytic::Plane(frame)) => {
                     let curve = self.curve(curve_id, geometry)?;
                     let range = self.edge_range(edge, &curve)?;
-                    let c = curve.nurbs(range).map_err(|x| self.fail(curve_id, super::strip(x)))?;
+                    let c = curve
+                        .nurbs(range)
+                        .map_err(|x| self.fail(curve_id, super::strip(x)))?;
                     Ok(vec![on_plane(&c, frame)])
                 }
                 _ => Err(self.fail(
                     geometry,
-                    format!("no PCURVE on the face's surface #{surface} (an edge without \
-                             one is read on planes only)"),
+                    format!(
+                        "no PCURVE on the face's surface #{surface} (an edge without \
+                             one is read on planes only)"
+                    ),
                 )),
             };
         }
@@ -678,7 +690,9 @@ impl<'a> Step<'a> {
             let ranges = self.same_parameter_range(pc, &plane, &curve, range, analytic)?;
             let mut segments = Vec::new();
             for range in &ranges {
-                let c = plane.nurbs(*range).map_err(|x| self.fail(pc, super::strip(x)))?;
+                let c = plane
+                    .nurbs(*range)
+                    .map_err(|x| self.fail(pc, super::strip(x)))?;
                 segments.extend(segments_2d(&c));
             }
             let range = ranges[0];
@@ -688,7 +702,12 @@ impl<'a> Step<'a> {
                 // the surface: which one the loop needs, its chaining decides.
                 let turn = plane.point(range[0] + std::f64::consts::TAU) - plane.point(range[0]);
                 for k in [-1.0, 1.0] {
-                    out.push(segments.iter().map(|s| s.shifted(k * turn.x, k * turn.y)).collect());
+                    out.push(
+                        segments
+                            .iter()
+                            .map(|s| s.shifted(k * turn.x, k * turn.y))
+                            .collect(),
+                    );
                 }
             }
         }
@@ -703,9 +722,9 @@ impl<'a> Step<'a> {
         let e = self.part(edge, "EDGE_CURVE").unwrap_or(&[]);
         let vertex = |k: usize| -> Result<Vec3> {
             let v = self.reference(edge, e.get(k), "vertex")?;
-            let p = self.part(v, "VERTEX_POINT").ok_or_else(|| {
-                self.fail(edge, format!("its vertex #{v} is not a VERTEX_POINT"))
-            })?;
+            let p = self
+                .part(v, "VERTEX_POINT")
+                .ok_or_else(|| self.fail(edge, format!("its vertex #{v} is not a VERTEX_POINT")))?;
             self.vec3(self.reference(v, p.get(1), "vertex geometry")?, v)
         };
         let (start, end) = (vertex(1)?, vertex(2)?);
@@ -753,8 +772,7 @@ impl<'a> Step<'a> {
         let fail = || {
             self.fail(
                 pc,
-                "this pcurve does not run along its edge's 3-D curve on the face's surface"
-                    .into(),
+                "this pcurve does not run along its edge's 3-D curve on the face's surface".into(),
             )
         };
         // The pcurve's parameter where its point on the surface is `want`, from `guess`.
@@ -799,7 +817,10 @@ impl<'a> Step<'a> {
             return Ok(if tm >= t0 && tm <= t1 {
                 vec![[t0, t1]]
             } else {
-                [[t1, hi], [lo, t0]].into_iter().filter(|r| r[1] > r[0]).collect()
+                [[t1, hi], [lo, t0]]
+                    .into_iter()
+                    .filter(|r| r[1] > r[0])
+                    .collect()
             });
         }
         if !plane.periodic() {
@@ -936,13 +957,20 @@ impl Step<'_> {
         face: usize,
         loops: &[Vec<TrimSegment>],
     ) -> Result<(NurbsSurface, [Option<f64>; 2])> {
-        let boxed = loops.iter().flatten().map(|s| s.hull_box()).reduce(|a, b| {
-            [0, 1].map(|d| [a[d][0].min(b[d][0]), a[d][1].max(b[d][1])])
-        });
+        let boxed = loops
+            .iter()
+            .flatten()
+            .map(|s| s.hull_box())
+            .reduce(|a, b| [0, 1].map(|d| [a[d][0].min(b[d][0]), a[d][1].max(b[d][1])]));
         let extent = a.extent(boxed).ok_or_else(|| {
-            self.fail(face, "a face on an unbounded surface with no bounding loop".into())
+            self.fail(
+                face,
+                "a face on an unbounded surface with no bounding loop".into(),
+            )
         })?;
-        let (s, arcs) = a.nurbs(extent).map_err(|e| self.fail(face, super::strip(e)))?;
+        let (s, arcs) = a
+            .nurbs(extent)
+            .map_err(|e| self.fail(face, super::strip(e)))?;
         let scale = crate::geometry::Mat3::identity() * self.to_mm;
         Ok((s.transformed(&scale, &Vec3::zeros()), arcs))
     }
@@ -982,7 +1010,12 @@ fn chain(edges: &[Vec<Vec<TrimSegment>>]) -> Vec<TrimSegment> {
             if *steps > 100_000 {
                 return false;
             }
-            if k > 0 && !ok(edges[k - 1][picks[k - 1]].last().unwrap().end(), option[0].start()) {
+            if k > 0
+                && !ok(
+                    edges[k - 1][picks[k - 1]].last().unwrap().end(),
+                    option[0].start(),
+                )
+            {
                 continue;
             }
             picks[k] = i;

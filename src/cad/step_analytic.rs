@@ -56,11 +56,31 @@ pub(super) enum Analytic {
     Plane(Frame),
     /// Cylinder (`semi_angle` 0) or cone; `offset` moves the profile along its normal;
     /// `slant`: `v` is the length along the generatrix (OpenCascade's cone), not the height.
-    Cone { frame: Frame, radius: f64, semi_angle: f64, offset: f64, slant: bool },
-    Sphere { frame: Frame, radius: f64 },
-    Torus { frame: Frame, major: f64, minor: f64 },
-    Revolution { curve: Curve, origin: Vec3, axis: Vec3 },
-    Extrusion { curve: Curve, vector: Vec3 },
+    Cone {
+        frame: Frame,
+        radius: f64,
+        semi_angle: f64,
+        offset: f64,
+        slant: bool,
+    },
+    Sphere {
+        frame: Frame,
+        radius: f64,
+    },
+    Torus {
+        frame: Frame,
+        major: f64,
+        minor: f64,
+    },
+    Revolution {
+        curve: Curve,
+        origin: Vec3,
+        axis: Vec3,
+    },
+    Extrusion {
+        curve: Curve,
+        vector: Vec3,
+    },
 }
 
 /// The names of the surfaces this module reads, for messages.
@@ -89,7 +109,11 @@ impl Analytic {
     /// pcurves in that parameter), or `None` if not a cone.
     pub fn slanted(&self) -> Option<Analytic> {
         match self {
-            Analytic::Cone { semi_angle, slant: false, .. } if *semi_angle != 0.0 => {
+            Analytic::Cone {
+                semi_angle,
+                slant: false,
+                ..
+            } if *semi_angle != 0.0 => {
                 let mut c = self.clone();
                 if let Analytic::Cone { slant, .. } = &mut c {
                     *slant = true;
@@ -116,7 +140,13 @@ impl Analytic {
         let radial = |f: &Frame, a: f64| f.x * a.cos() + f.y * a.sin();
         match self {
             Analytic::Plane(f) => f.origin + f.x * u + f.y * v,
-            Analytic::Cone { frame: f, radius, semi_angle: a, offset: d, slant } => {
+            Analytic::Cone {
+                frame: f,
+                radius,
+                semi_angle: a,
+                offset: d,
+                slant,
+            } => {
                 let [kr, kz] = generatrix(*a, *slant);
                 let rho = radius + v * kr + d * a.cos();
                 f.origin + radial(f, u) * rho + f.z * (v * kz - d * a.sin())
@@ -124,12 +154,16 @@ impl Analytic {
             Analytic::Sphere { frame: f, radius } => {
                 f.origin + radial(f, u) * (radius * v.cos()) + f.z * (radius * v.sin())
             }
-            Analytic::Torus { frame: f, major, minor } => {
-                f.origin + radial(f, u) * (major + minor * v.cos()) + f.z * (minor * v.sin())
-            }
-            Analytic::Revolution { curve, origin, axis } => {
-                origin + rotated(curve.point(v) - origin, *axis, u)
-            }
+            Analytic::Torus {
+                frame: f,
+                major,
+                minor,
+            } => f.origin + radial(f, u) * (major + minor * v.cos()) + f.z * (minor * v.sin()),
+            Analytic::Revolution {
+                curve,
+                origin,
+                axis,
+            } => origin + rotated(curve.point(v) - origin, *axis, u),
             Analytic::Extrusion { curve, vector } => curve.point(u) + vector * v,
         }
     }
@@ -138,7 +172,13 @@ impl Analytic {
     /// and `z` whose turn about `z` is the surface.
     fn profile(&self, range: [f64; 2]) -> Option<Result<NurbsCurve>> {
         Some(match self {
-            Analytic::Cone { frame: f, radius, semi_angle: a, offset: d, slant } => {
+            Analytic::Cone {
+                frame: f,
+                radius,
+                semi_angle: a,
+                offset: d,
+                slant,
+            } => {
                 let [kr, kz] = generatrix(*a, *slant);
                 let origin = f.origin + f.x * (radius + d * a.cos()) - f.z * (d * a.sin());
                 NurbsCurve::ray(origin, f.x * kr + f.z * kz, range)
@@ -146,9 +186,11 @@ impl Analytic {
             Analytic::Sphere { frame: f, radius } => {
                 NurbsCurve::arc(f.origin, f.x, f.z, *radius, range)
             }
-            Analytic::Torus { frame: f, major, minor } => {
-                NurbsCurve::arc(f.origin + f.x * *major, f.x, f.z, *minor, range)
-            }
+            Analytic::Torus {
+                frame: f,
+                major,
+                minor,
+            } => NurbsCurve::arc(f.origin + f.x * *major, f.x, f.z, *minor, range),
             _ => return None,
         })
     }
@@ -161,7 +203,10 @@ impl Analytic {
             let s = NurbsSurface::new(
                 [1, 1],
                 [vec![u[0], u[0], u[1], u[1]], vec![v[0], v[0], v[1], v[1]]],
-                vec![vec![at(u[0], v[0]), at(u[0], v[1])], vec![at(u[1], v[0]), at(u[1], v[1])]],
+                vec![
+                    vec![at(u[0], v[0]), at(u[0], v[1])],
+                    vec![at(u[1], v[0]), at(u[1], v[1])],
+                ],
                 None,
             )?;
             return Ok((s, [None, None]));
@@ -178,7 +223,11 @@ impl Analytic {
             return Ok((s.transposed(), [Some(half), profile.arc_half_angle]));
         }
         match self {
-            Analytic::Revolution { curve, origin, axis } => {
+            Analytic::Revolution {
+                curve,
+                origin,
+                axis,
+            } => {
                 let c = curve.nurbs(v)?;
                 let (s, half) = revolution(&c, *origin, *axis, u)?;
                 Ok((s.transposed(), [Some(half), c.arc_half_angle]))
@@ -214,8 +263,20 @@ impl Analytic {
             }
             // A swept B-spline ends where its knots do (the loops reach it to rounding).
             match (self, d) {
-                (Analytic::Revolution { curve: Curve::Spline(c), .. }, 1)
-                | (Analytic::Extrusion { curve: Curve::Spline(c), .. }, 0) => {
+                (
+                    Analytic::Revolution {
+                        curve: Curve::Spline(c),
+                        ..
+                    },
+                    1,
+                )
+                | (
+                    Analytic::Extrusion {
+                        curve: Curve::Spline(c),
+                        ..
+                    },
+                    0,
+                ) => {
                     out[d] = [out[d][0].max(c.range[0]), out[d][1].min(c.range[1])];
                 }
                 _ => {}
@@ -254,13 +315,19 @@ impl Step<'_> {
             if x > 0.0 {
                 Ok(x)
             } else {
-                Err(self.fail(id, format!("its {what} {x} (with the offset {d}) is not > 0")))
+                Err(self.fail(
+                    id,
+                    format!("its {what} {x} (with the offset {d}) is not > 0"),
+                ))
             }
         };
         let out = match name.as_str() {
             "PLANE" => {
                 let f = frame()?;
-                Analytic::Plane(Frame { origin: f.origin + f.z * d, ..f })
+                Analytic::Plane(Frame {
+                    origin: f.origin + f.z * d,
+                    ..f
+                })
             }
             "CYLINDRICAL_SURFACE" | "CONICAL_SURFACE" => {
                 let radius = length(2, "radius")?;
@@ -270,12 +337,21 @@ impl Step<'_> {
                     0.0
                 };
                 if semi_angle.abs() >= FRAC_PI_2 {
-                    return Err(self.fail(id, format!("its semi-angle {semi_angle} is not below pi/2 (radians)")));
+                    return Err(self.fail(
+                        id,
+                        format!("its semi-angle {semi_angle} is not below pi/2 (radians)"),
+                    ));
                 }
                 if semi_angle == 0.0 {
                     positive(radius + d, "radius")?;
                 }
-                Analytic::Cone { frame: frame()?, radius, semi_angle, offset: d, slant: false }
+                Analytic::Cone {
+                    frame: frame()?,
+                    radius,
+                    semi_angle,
+                    offset: d,
+                    slant: false,
+                }
             }
             "SPHERICAL_SURFACE" => Analytic::Sphere {
                 frame: frame()?,
@@ -287,10 +363,13 @@ impl Step<'_> {
                 minor: positive(length(3, "minor radius")? + d, "minor radius")?,
             },
             "SURFACE_OF_REVOLUTION" | "SURFACE_OF_LINEAR_EXTRUSION" if d != 0.0 => {
-                return Err(self.fail(id, format!(
-                    "an OFFSET_SURFACE of a {name} is not read (its offset is not rational); \
+                return Err(self.fail(
+                    id,
+                    format!(
+                        "an OFFSET_SURFACE of a {name} is not read (its offset is not rational); \
                      export the face as a B-spline surface"
-                )))
+                    ),
+                ))
             }
             "SURFACE_OF_REVOLUTION" => {
                 let curve = self.curve(self.reference(id, p.get(1), "swept curve")?, id)?;
@@ -303,7 +382,11 @@ impl Step<'_> {
                     Some(Value::Ref(r)) => self.direction(*r, a)?,
                     _ => Vec3::z(),
                 };
-                Analytic::Revolution { curve, origin, axis }
+                Analytic::Revolution {
+                    curve,
+                    origin,
+                    axis,
+                }
             }
             "SURFACE_OF_LINEAR_EXTRUSION" => {
                 let curve = self.curve(self.reference(id, p.get(1), "swept curve")?, id)?;
@@ -320,14 +403,23 @@ impl Step<'_> {
                 let distance = self.number(id, p.get(2), "distance")?;
                 return match self.analytic_offset(basis, face, d + distance, depth + 1)? {
                     Some(a) => Ok(Some(a)),
-                    None => Err(self.fail(id, format!(
-                        "an OFFSET_SURFACE of the B-spline surface #{basis} is not read; \
+                    None => Err(self.fail(
+                        id,
+                        format!(
+                            "an OFFSET_SURFACE of the B-spline surface #{basis} is not read; \
                          export the face as a B-spline surface"
-                    ))),
+                        ),
+                    )),
                 };
             }
-            _ if inst.parts.iter().any(|(n, _)| n == "B_SPLINE_SURFACE_WITH_KNOTS") => {
-                return if d == 0.0 { Ok(None) } else {
+            _ if inst
+                .parts
+                .iter()
+                .any(|(n, _)| n == "B_SPLINE_SURFACE_WITH_KNOTS") =>
+            {
+                return if d == 0.0 {
+                    Ok(None)
+                } else {
                     Err(self.fail(id, "an offset B-spline surface is not read".into()))
                 };
             }

@@ -73,9 +73,13 @@ impl Curve {
                 unit = unit.transformed(&map, &frame.origin);
                 Ok(unit)
             }
-            Curve::Spline(c) => {
-                NurbsCurve::new(c.degree, c.knots.clone(), c.points.clone(), c.weights.clone(), range)
-            }
+            Curve::Spline(c) => NurbsCurve::new(
+                c.degree,
+                c.knots.clone(),
+                c.points.clone(),
+                c.weights.clone(),
+                range,
+            ),
         }
     }
 
@@ -133,9 +137,9 @@ fn nearest_parameter(c: &NurbsCurve, p: Vec3) -> f64 {
 impl Step<'_> {
     /// A `DIRECTION` (2 or 3 components, padded with 0), normalised.
     pub(super) fn direction(&self, id: usize, from: usize) -> Result<Vec3> {
-        let p = self.part(id, "DIRECTION").ok_or_else(|| {
-            self.fail(from, format!("its direction #{id} is not a DIRECTION"))
-        })?;
+        let p = self
+            .part(id, "DIRECTION")
+            .ok_or_else(|| self.fail(from, format!("its direction #{id} is not a DIRECTION")))?;
         let c = self.list(id, p.get(1), "direction ratios")?;
         let c: Vec<f64> = c
             .iter()
@@ -173,12 +177,20 @@ impl Step<'_> {
             };
             (origin, Vec3::z(), x)
         } else {
-            return Err(self.fail(from, format!("its placement #{id} is not an AXIS2_PLACEMENT")));
+            return Err(self.fail(
+                from,
+                format!("its placement #{id} is not an AXIS2_PLACEMENT"),
+            ));
         };
         let x = (x - z * x.dot(&z))
             .try_normalize(1e-12)
             .ok_or_else(|| self.fail(id, "its reference direction is along its axis".into()))?;
-        Ok(Frame { origin, x, y: z.cross(&x), z })
+        Ok(Frame {
+            origin,
+            x,
+            y: z.cross(&x),
+            z,
+        })
     }
 
     /// A curve instance (see the module docs), in the file's unit.
@@ -195,23 +207,32 @@ impl Step<'_> {
         if let Some(p) = self.part(id, "LINE") {
             let origin = self.vec3(self.reference(id, p.get(1), "point")?, id)?;
             let v = self.reference(id, p.get(2), "vector")?;
-            let q = self.part(v, "VECTOR").ok_or_else(|| {
-                self.fail(id, format!("its direction #{v} is not a VECTOR"))
-            })?;
+            let q = self
+                .part(v, "VECTOR")
+                .ok_or_else(|| self.fail(id, format!("its direction #{v} is not a VECTOR")))?;
             let d = self.direction(self.reference(v, q.get(1), "orientation")?, v)?;
             let m = self.number(v, q.get(2), "magnitude")?;
             if m == 0.0 {
                 return Err(self.fail(v, "a vector of magnitude zero".into()));
             }
-            return Ok(Curve::Line { origin, step: d * m });
+            return Ok(Curve::Line {
+                origin,
+                step: d * m,
+            });
         }
         if let Some(p) = self.part(id, "CIRCLE") {
             let frame = self.frame(self.reference(id, p.get(1), "position")?, id)?;
-            return Ok(Curve::Circle { frame, radius: positive(p.get(2), "radius")? });
+            return Ok(Curve::Circle {
+                frame,
+                radius: positive(p.get(2), "radius")?,
+            });
         }
         if let Some(p) = self.part(id, "ELLIPSE") {
             let frame = self.frame(self.reference(id, p.get(1), "position")?, id)?;
-            let (a, b) = (positive(p.get(2), "semi axis 1")?, positive(p.get(3), "semi axis 2")?);
+            let (a, b) = (
+                positive(p.get(2), "semi axis 1")?,
+                positive(p.get(3), "semi axis 2")?,
+            );
             return Ok(Curve::Ellipse { frame, a, b });
         }
         if self.part(id, "B_SPLINE_CURVE_WITH_KNOTS").is_some() {

@@ -286,7 +286,10 @@ pub fn select(
 /// (its `ζ` axis is the thickness direction). Errors name the fault and the element.
 pub fn check_columns(mesh: &Mesh) -> Result<()> {
     if mesh.columns().is_empty() {
-        let why = mesh.columns_fault().map(|f| format!(": {f}")).unwrap_or_default();
+        let why = mesh
+            .columns_fault()
+            .map(|f| format!(": {f}"))
+            .unwrap_or_default();
         return Err(Error::Input(format!(
             "element \"solid_shell\": the mesh has no through-thickness node columns{why} (a \
              block mesh has them, also after mesh.map, and an imported or merged sheet of \

@@ -603,55 +603,15 @@ mod tests {
         Hill48::from_lankford(0.7, 1.3, 2.1).unwrap()
     }
 
-    /// Direction vector `q = [c², s², 0, cs, 0, 0]` of uniaxial loading at `angle` to x:
-    /// `q·ε` is the normal strain along the direction (engineering shear) and `s q` the
-    /// uniaxial stress `s a⊗a` (tensor shear), so one vector serves both.
-    fn direction(angle: f64) -> Voigt {
-        let (s, c) = angle.sin_cos();
-        Voigt::new(c * c, s * s, 0.0, c * s, 0.0, 0.0)
-    }
-
-    /// Uniaxial stress along `angle` to x, driven by the strain `q·ε` in `steps` equal
-    /// increments up to `eps_max`: at each step Newton with the material's consistent
-    /// tangent solves the mixed problem `σ(ε) = s q`, `q·ε = target` for `(ε, s)`, all
-    /// other stress components zero (plane stress `σzz = 0` included). Returns the
-    /// committed state after every step.
+    /// Uniaxial stress along `angle` to x, its strain along the direction raised in
+    /// `steps` equal increments up to `eps_max` (the shared driver,
+    /// `material::uniaxial_stress_path`); the committed state after every step.
     fn uniaxial(m: &ElastoPlastic, angle: f64, eps_max: f64, steps: usize) -> Vec<PointState> {
-        let q = direction(angle);
-        let mut committed = m.initial_state();
-        let mut states = Vec::new();
-        for k in 1..=steps {
-            let target = eps_max * k as f64 / steps as f64;
-            let mut eps = committed.strain;
-            let mut s = q.dot(&committed.stress);
-            let mut trial = committed;
-            let mut converged = false;
-            for _ in 0..40 {
-                let d = m
-                    .update(&Kinematics::from_strain(eps), &committed, &mut trial)
-                    .unwrap();
-                let r_sig = trial.stress - q * s;
-                let r_eps = q.dot(&eps) - target;
-                if r_sig.amax() <= 1e-10 * s.abs().max(1.0) && r_eps.abs() < 1e-15 {
-                    converged = true;
-                    break;
-                }
-                let mut jac = SMatrix::<f64, 7, 7>::zeros();
-                jac.fixed_view_mut::<6, 6>(0, 0).copy_from(&d);
-                jac.fixed_view_mut::<6, 1>(0, 6).copy_from(&(-q));
-                jac.fixed_view_mut::<1, 6>(6, 0).copy_from(&q.transpose());
-                let rhs = -SVector::<f64, 7>::from_iterator(
-                    r_sig.iter().copied().chain(std::iter::once(r_eps)),
-                );
-                let dx = jac.lu().solve(&rhs).unwrap();
-                eps += dx.fixed_rows::<6>(0);
-                s += dx[6];
-            }
-            assert!(converged, "uniaxial driver, step {k}");
-            committed = trial;
-            states.push(committed);
-        }
-        states
+        let targets: Vec<f64> = (1..=steps)
+            .map(|k| eps_max * k as f64 / steps as f64)
+            .collect();
+        super::super::uniaxial_stress_path(m, super::super::uniaxial_direction(angle), &targets)
+            .unwrap()
     }
 
     #[test]

@@ -370,39 +370,8 @@ mod tests {
     /// each increment): per increment, Newton with the consistent tangent on the mixed
     /// problem `σ = s e_x`, `εxx = target`. Returns the committed states.
     fn uniaxial(m: &ElastoPlastic, targets: &[f64]) -> Vec<PointState> {
-        let q = Voigt::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-        let mut committed = m.initial_state();
-        let mut states = Vec::new();
-        for (k, &target) in targets.iter().enumerate() {
-            let (mut eps, mut s) = (committed.strain, committed.stress[0]);
-            let mut trial = committed;
-            let mut converged = false;
-            for _ in 0..40 {
-                let d = m
-                    .update(&Kinematics::from_strain(eps), &committed, &mut trial)
-                    .unwrap();
-                let r_sig = trial.stress - q * s;
-                let r_eps = eps[0] - target;
-                if r_sig.amax() <= 1e-10 * s.abs().max(1.0) && r_eps.abs() < 1e-15 {
-                    converged = true;
-                    break;
-                }
-                let mut jac = SMatrix::<f64, 7, 7>::zeros();
-                jac.fixed_view_mut::<6, 6>(0, 0).copy_from(&d);
-                jac.fixed_view_mut::<6, 1>(0, 6).copy_from(&(-q));
-                jac.fixed_view_mut::<1, 6>(6, 0).copy_from(&q.transpose());
-                let rhs = -SVector::<f64, 7>::from_iterator(
-                    r_sig.iter().copied().chain(std::iter::once(r_eps)),
-                );
-                let dx = jac.lu().solve(&rhs).unwrap();
-                eps += dx.fixed_rows::<6>(0);
-                s += dx[6];
-            }
-            assert!(converged, "uniaxial driver, increment {k}");
-            committed = trial;
-            states.push(committed);
-        }
-        states
+        super::super::uniaxial_stress_path(m, super::super::uniaxial_direction(0.0), targets)
+            .unwrap()
     }
 
     /// Strain targets 0 -> +amp -> -amp -> +amp in `per_branch` increments per `amp`.

@@ -39,12 +39,14 @@ mod linear_elastic;
 pub mod log_strain;
 mod spectral_return;
 mod sym_eigen3;
+mod uniaxial;
 
 pub use elastoplastic::ElastoPlastic;
 pub use hardening::Hardening;
 pub use hill48::Hill48;
 pub use kinematic::Chaboche;
 pub use linear_elastic::LinearElastic;
+pub use uniaxial::{uniaxial_direction, uniaxial_stress_path};
 
 /// A symmetric tensor in Voigt notation `[xx, yy, zz, xy, yz, zx]`; see the module
 /// documentation for the stress / strain (engineering shear) convention.

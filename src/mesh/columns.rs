@@ -215,8 +215,9 @@ fn walk_stacks(mesh: &Mesh, faces: &FaceIndex, bottom: &[usize], top: &[usize]) 
     for &i in top {
         on_top[i] = true;
     }
-    let boundary_index: HashMap<(usize, usize), usize> =
-        (faces.boundary.iter().enumerate()).map(|(i, &ef)| (ef, i)).collect();
+    let boundary_index: HashMap<(usize, usize), usize> = (faces.boundary.iter().enumerate())
+        .map(|(i, &ef)| (ef, i))
+        .collect();
     let n = mesh.nodes.len();
     let mut entry_face: Vec<Option<usize>> = vec![None; mesh.hexes.len()];
     let mut stack_of: Vec<usize> = vec![usize::MAX; mesh.hexes.len()];
@@ -242,7 +243,9 @@ fn walk_stacks(mesh: &Mesh, faces: &FaceIndex, bottom: &[usize], top: &[usize]) 
                 link(&mut down, hi, lo, e, "below")?;
             }
             let out = f ^ 1;
-            let next = faces.by_nodes[&key(hex, out)].iter().find(|&&(o, _)| o != e);
+            let next = faces.by_nodes[&key(hex, out)]
+                .iter()
+                .find(|&&(o, _)| o != e);
             match next {
                 Some(&(e2, f2)) => (e, f) = (e2, f2),
                 None if on_top[boundary_index[&(e, out)]] => break,
@@ -271,7 +274,13 @@ fn walk_stacks(mesh: &Mesh, faces: &FaceIndex, bottom: &[usize], top: &[usize]) 
 }
 
 /// Records `map[from] = to`, an error naming `element` if `from` already has another.
-fn link(map: &mut [Option<usize>], from: usize, to: usize, element: usize, side: &str) -> Result<()> {
+fn link(
+    map: &mut [Option<usize>],
+    from: usize,
+    to: usize,
+    element: usize,
+    side: &str,
+) -> Result<()> {
     match map[from] {
         Some(other) if other != to => Err(Error::Input(format!(
             "element {element}: node {from} has two nodes {side} it ({other} and {to}); the \
@@ -358,7 +367,10 @@ mod tests {
         m.detect_columns();
         assert_eq!(m.columns_fault(), None);
         assert_eq!(m.columns(), built.as_slice());
-        assert_eq!(m.hexes, hexes, "a block's elements already stand in their columns");
+        assert_eq!(
+            m.hexes, hexes,
+            "a block's elements already stand in their columns"
+        );
     }
 
     /// Every rotation of every element's numbering is undone: the elements stand upright
@@ -390,8 +402,11 @@ mod tests {
             a.sort_unstable();
             b.sort_unstable();
             assert_eq!(a, b, "element {e} keeps its nodes");
-            assert_eq!(got[..4].iter().map(|&n| m.nodes[n].z).sum::<f64>(),
-                       want[..4].iter().map(|&n| m.nodes[n].z).sum::<f64>(), "element {e}");
+            assert_eq!(
+                got[..4].iter().map(|&n| m.nodes[n].z).sum::<f64>(),
+                want[..4].iter().map(|&n| m.nodes[n].z).sum::<f64>(),
+                "element {e}"
+            );
         }
         // What the solid-shell needs: local node a + 4 one step above node a in its column.
         let mut place = vec![(0, 0); m.node_count()];
@@ -412,7 +427,12 @@ mod tests {
     #[test]
     fn stacked_blocks_make_longer_columns() {
         let a = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 1.0, 0.5), [2, 1, 1]).unwrap();
-        let b = Mesh::block(Vec3::new(0.0, 0.0, 0.5), Vec3::new(2.0, 1.0, 0.5), [2, 1, 2]).unwrap();
+        let b = Mesh::block(
+            Vec3::new(0.0, 0.0, 0.5),
+            Vec3::new(2.0, 1.0, 0.5),
+            [2, 1, 2],
+        )
+        .unwrap();
         let mut m = a.merged(&b, 1e-9).unwrap();
         m.detect_columns();
         assert_eq!(m.columns().len(), 6);
@@ -426,7 +446,12 @@ mod tests {
     fn non_sheet_names_an_element() {
         // 3 cells deep in y, so that the L is no sheet along y either.
         let a = Mesh::block(Vec3::zeros(), Vec3::new(2.0, 3.0, 1.0), [2, 3, 1]).unwrap();
-        let b = Mesh::block(Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 3.0, 1.0), [1, 3, 1]).unwrap();
+        let b = Mesh::block(
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 3.0, 1.0),
+            [1, 3, 1],
+        )
+        .unwrap();
         let mut m = a.merged(&b, 1e-9).unwrap();
         m.detect_columns();
         assert!(m.columns().is_empty());

@@ -58,31 +58,84 @@ impl FldChart<'_> {
         let sy = |y: f64| bottom - (y - y0) / (y1 - y0) * (bottom - top);
         let mut out = String::new();
         svg_open(&mut out, width, height);
-        text(&mut out, (left + right) / 2.0, 26.0, 17.0, "middle", " font-weight=\"bold\"", &self.title);
-        text(&mut out, (left + right) / 2.0, 46.0, 11.0, "middle", "", &self.subtitle);
+        text(
+            &mut out,
+            (left + right) / 2.0,
+            26.0,
+            17.0,
+            "middle",
+            " font-weight=\"bold\"",
+            &self.title,
+        );
+        text(
+            &mut out,
+            (left + right) / 2.0,
+            46.0,
+            11.0,
+            "middle",
+            "",
+            &self.subtitle,
+        );
         out.push_str("<g stroke=\"#e0e0e0\" stroke-width=\"1\">\n");
         for &t in &xt {
-            let _ = writeln!(out, "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\"/>", px(sx(t)), px(top), px(bottom));
+            let _ = writeln!(
+                out,
+                "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\"/>",
+                px(sx(t)),
+                px(top),
+                px(bottom)
+            );
         }
         for &t in &yt {
-            let _ = writeln!(out, "<line x1=\"{1}\" y1=\"{0}\" x2=\"{2}\" y2=\"{0}\"/>", px(sy(t)), px(left), px(right));
+            let _ = writeln!(
+                out,
+                "<line x1=\"{1}\" y1=\"{0}\" x2=\"{2}\" y2=\"{0}\"/>",
+                px(sy(t)),
+                px(left),
+                px(right)
+            );
         }
         out.push_str("</g>\n");
-        let _ = writeln!(
+        let _ =
+            writeln!(
             out,
             "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#333\"/>",
             px(left), px(top), px(right - left), px(bottom - top)
         );
         for &t in &xt {
-            text(&mut out, sx(t), bottom + 18.0, 12.0, "middle", "", &tick_label(t, xs));
+            text(
+                &mut out,
+                sx(t),
+                bottom + 18.0,
+                12.0,
+                "middle",
+                "",
+                &tick_label(t, xs),
+            );
         }
         for &t in &yt {
             y_tick_label(&mut out, left, sy(t), &tick_label(t, ys));
         }
-        text(&mut out, (left + right) / 2.0, height - 18.0, 14.0, "middle", "", "minor strain [%]");
+        text(
+            &mut out,
+            (left + right) / 2.0,
+            height - 18.0,
+            14.0,
+            "middle",
+            "",
+            "minor strain [%]",
+        );
         let (lx, ly) = (22.0, (top + bottom) / 2.0);
         let rotate = format!(" transform=\"rotate(-90 {} {})\"", px(lx), px(ly));
-        text(&mut out, lx, ly, 14.0, "middle", &rotate, "major strain [%]");
+        text(
+            &mut out,
+            lx,
+            ly,
+            14.0,
+            "middle",
+            &rotate,
+            "major strain [%]",
+        );
         let _ = writeln!(
             out,
             "<clipPath id=\"plot\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath>\n<g clip-path=\"url(#plot)\">",
@@ -114,22 +167,39 @@ impl FldChart<'_> {
         let legend: Vec<(String, &str, bool)> = (Zone::ALL.iter().rev())
             .map(|z| {
                 let n = f.zone.iter().filter(|&&q| q == *z).count();
-                (format!("{} ({n})", z.name().replace('_', " ")), z.colour(), false)
+                (
+                    format!("{} ({n})", z.name().replace('_', " ")),
+                    z.colour(),
+                    false,
+                )
             })
             .chain(f.flc.iter().flat_map(|_| {
                 [
                     ("forming limit curve".to_string(), "#000", true),
-                    (format!("FLC - {}", fmt_f64(self.safety_margin)), "#000", true),
+                    (
+                        format!("FLC - {}", fmt_f64(self.safety_margin)),
+                        "#000",
+                        true,
+                    ),
                 ]
             }))
             .collect();
         for (i, (name, colour, line)) in legend.iter().enumerate() {
             let y = top + 10.0 + 20.0 * i as f64;
             if *line {
-                let dash = if i + 1 == legend.len() { " stroke-dasharray=\"6 4\"" } else { "" };
+                let dash = if i + 1 == legend.len() {
+                    " stroke-dasharray=\"6 4\""
+                } else {
+                    ""
+                };
                 let _ = writeln!(out, "<line x1=\"{0}\" y1=\"{1}\" x2=\"{2}\" y2=\"{1}\" stroke=\"{colour}\" stroke-width=\"2\"{dash}/>", px(right + 14.0), px(y), px(right + 36.0));
             } else {
-                let _ = writeln!(out, "<circle cx=\"{}\" cy=\"{}\" r=\"5\" fill=\"{colour}\"/>", px(right + 25.0), px(y));
+                let _ = writeln!(
+                    out,
+                    "<circle cx=\"{}\" cy=\"{}\" r=\"5\" fill=\"{colour}\"/>",
+                    px(right + 25.0),
+                    px(y)
+                );
             }
             text(&mut out, right + 42.0, y + 4.0, 12.0, "start", "", name);
         }
@@ -140,7 +210,8 @@ impl FldChart<'_> {
     /// The points as CSV: `column,minor_strain,major_strain,thinning_pct,flc_margin,zone`.
     pub fn to_csv(&self) -> String {
         let f = self.formability;
-        let mut out = String::from("column,minor_strain,major_strain,thinning_pct,flc_margin,zone\n");
+        let mut out =
+            String::from("column,minor_strain,major_strain,thinning_pct,flc_margin,zone\n");
         for k in 0..f.zone.len() {
             let _ = writeln!(
                 out,
@@ -148,7 +219,11 @@ impl FldChart<'_> {
                 fmt_f64(f.columns.minor[k]),
                 fmt_f64(f.columns.major[k]),
                 fmt_f64(f.thinning(k)),
-                if f.margin[k].is_finite() { fmt_f64(f.margin[k]) } else { String::new() },
+                if f.margin[k].is_finite() {
+                    fmt_f64(f.margin[k])
+                } else {
+                    String::new()
+                },
                 f.zone[k].name()
             );
         }
@@ -176,7 +251,9 @@ mod tests {
             initial_thickness: vec![0.8, 0.8, 0.8],
         };
         let flc = Flc::keeler_brazier(0.2, 0.8).unwrap();
-        let margin: Vec<f64> = (0..3).map(|k| flc.margin(columns.major[k], columns.minor[k])).collect();
+        let margin: Vec<f64> = (0..3)
+            .map(|k| flc.margin(columns.major[k], columns.minor[k]))
+            .collect();
         let t = Thresholds::default();
         let zone = (0..3)
             .map(|k| {
@@ -189,7 +266,12 @@ mod tests {
                 crate::output::formability::zone(&p, Some(margin[k]), &t)
             })
             .collect();
-        let f = Formability { flc: Some(flc), columns, margin, zone };
+        let f = Formability {
+            flc: Some(flc),
+            columns,
+            margin,
+            zone,
+        };
         let chart = FldChart {
             title: "DC04 <steel>".into(),
             subtitle: "Swift n = 0.2".into(),
@@ -198,10 +280,17 @@ mod tests {
         };
         let svg = chart.to_svg();
         assert_well_formed(&svg);
-        assert_eq!(svg.matches("<circle").count(), 3 + 7, "3 points and 7 legend markers");
+        assert_eq!(
+            svg.matches("<circle").count(),
+            3 + 7,
+            "3 points and 7 legend markers"
+        );
         assert_eq!(svg.matches("<polyline").count(), 2, "curve and margin line");
         assert!(svg.contains("DC04 &lt;steel&gt;"));
-        assert!(svg.contains(">crack (1)</text>"), "the 40 % major strain point is beyond the curve");
+        assert!(
+            svg.contains(">crack (1)</text>"),
+            "the 40 % major strain point is beyond the curve"
+        );
         let csv = chart.to_csv();
         assert_eq!(csv.lines().count(), 4);
         assert!(csv.lines().nth(3).unwrap().ends_with(",crack"));

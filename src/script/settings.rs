@@ -154,10 +154,14 @@ pub(super) const SETTINGS: &[Setting] = &[
         Ok(())
     }),
     // Formability: the forming limit curve and the zone thresholds.
-    setting("flc", "[[-0.2, 0.5], [0.0, 0.3], [0.3, 0.45]]", |_, k, v| {
-        k.frames.formability.flc = Some(flc_table(v)?);
-        Ok(())
-    }),
+    setting(
+        "flc",
+        "[[-0.2, 0.5], [0.0, 0.3], [0.3, 0.45]]",
+        |_, k, v| {
+            k.frames.formability.flc = Some(flc_table(v)?);
+            Ok(())
+        },
+    ),
     setting("flc_safety_margin", "0.05", |_, k, v| {
         k.frames.formability.thresholds.safety_margin = non_negative(v)?;
         Ok(())
@@ -468,7 +472,10 @@ fn flc_table(v: Value) -> ScriptResult<Flc> {
     };
     let mut points = Vec::with_capacity(rows.len());
     for (i, row) in rows.iter().enumerate() {
-        let pair = row.clone().try_cast::<rhai::Array>().filter(|r| r.len() == 2);
+        let pair = row
+            .clone()
+            .try_cast::<rhai::Array>()
+            .filter(|r| r.len() == 2);
         let Some(pair) = pair else {
             return runtime_error(format!("{} point {i} must be a [minor, major] pair", v.key));
         };

@@ -99,7 +99,10 @@ fn measure(v: &CupVariant, scratch: &std::path::Path) -> Result<Measured> {
         ("charts".to_string(), Dynamic::from(false)),
         // The script's default for one layer is the solid-shell; the study's families are
         // F-bar hexahedra (docs/studies/square_cup).
-        ("element".to_string(), Dynamic::from(cup_reference::HEXAHEDRON.to_string())),
+        (
+            "element".to_string(),
+            Dynamic::from(cup_reference::HEXAHEDRON.to_string()),
+        ),
     ];
     let mut base = rhai::Map::new();
     // One frame at the start and one at the end: the study needs the summary only.

@@ -55,10 +55,18 @@ impl Flc {
     /// The Keeler-Brazier curve; `n >= 0` and `thickness_mm > 0`, both finite.
     pub fn keeler_brazier(n: f64, thickness_mm: f64) -> Result<Flc> {
         if !(n.is_finite() && n >= 0.0) {
-            return Err(Error::input("FLC hardening exponent n", n, "must be finite and >= 0"));
+            return Err(Error::input(
+                "FLC hardening exponent n",
+                n,
+                "must be finite and >= 0",
+            ));
         }
         if !(thickness_mm.is_finite() && thickness_mm > 0.0) {
-            return Err(Error::input("FLC sheet thickness", thickness_mm, "must be finite and > 0 (mm)"));
+            return Err(Error::input(
+                "FLC sheet thickness",
+                thickness_mm,
+                "must be finite and > 0 (mm)",
+            ));
         }
         Ok(Flc::KeelerBrazier { n, thickness_mm })
     }
@@ -66,11 +74,15 @@ impl Flc {
     /// A table of `[minor, major]` points: at least one, finite, minor strictly increasing.
     pub fn table(points: Vec<[f64; 2]>) -> Result<Flc> {
         if points.is_empty() {
-            return Err(Error::Input("flc: the table has no point ([minor, major] pairs)".into()));
+            return Err(Error::Input(
+                "flc: the table has no point ([minor, major] pairs)".into(),
+            ));
         }
         for (i, p) in points.iter().enumerate() {
             if !(p[0].is_finite() && p[1].is_finite()) {
-                return Err(Error::Input(format!("flc: point {i} = {p:?} must be finite")));
+                return Err(Error::Input(format!(
+                    "flc: point {i} = {p:?} must be finite"
+                )));
             }
             if i > 0 && p[0] <= points[i - 1][0] {
                 return Err(Error::Input(format!(
@@ -275,12 +287,17 @@ mod tests {
         }
         let t = Flc::table(vec![[-0.2, 0.5], [0.0, 0.3], [0.3, 0.45]]).unwrap();
         assert!((t.major_limit(-0.1) - 0.4).abs() < 1e-15);
-        assert!((t.major_limit(0.6) - 0.6).abs() < 1e-14, "the last segment extended");
+        assert!(
+            (t.major_limit(0.6) - 0.6).abs() < 1e-14,
+            "the last segment extended"
+        );
     }
 
     #[test]
     fn bad_tables_are_refused_by_point() {
-        let e = Flc::table(vec![[0.0, 0.3], [0.0, 0.4]]).unwrap_err().to_string();
+        let e = Flc::table(vec![[0.0, 0.3], [0.0, 0.4]])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("point 1"), "{e}");
         let e = Flc::table(vec![[f64::NAN, 0.3]]).unwrap_err().to_string();
         assert!(e.contains("point 0"), "{e}");
@@ -310,12 +327,21 @@ mod tests {
         thin.thinning_pct = 25.0 + 1e-9;
         assert_eq!(zone(&thin, None, &t), Zone::ExcessiveThinning);
         assert_eq!(zone(&p(0.1, -0.12, 0.02), None, &t), Zone::Compression);
-        assert_eq!(zone(&p(0.1, -0.12, 0.02 + 1e-12), None, &t), Zone::Wrinkling);
+        assert_eq!(
+            zone(&p(0.1, -0.12, 0.02 + 1e-12), None, &t),
+            Zone::Wrinkling
+        );
         assert_eq!(zone(&p(0.1, -0.12, 0.0), None, &t), Zone::Safe);
         assert_eq!(zone(&p(0.02, 0.0, -0.02), None, &t), Zone::Safe);
-        assert_eq!(zone(&p(0.02 - 1e-12, 0.0, -0.02), None, &t), Zone::InsufficientStretch);
+        assert_eq!(
+            zone(&p(0.02 - 1e-12, 0.0, -0.02), None, &t),
+            Zone::InsufficientStretch
+        );
         assert_eq!(zone(&p(0.01, -0.02, 0.01), None, &t), Zone::Compression);
-        assert_eq!(zone(&p(0.01, -0.02 + 1e-12, 0.01), None, &t), Zone::InsufficientStretch);
+        assert_eq!(
+            zone(&p(0.01, -0.02 + 1e-12, 0.01), None, &t),
+            Zone::InsufficientStretch
+        );
         let codes: Vec<u8> = Zone::ALL.iter().map(|z| z.code()).collect();
         assert_eq!(codes, (0..7).collect::<Vec<u8>>());
     }

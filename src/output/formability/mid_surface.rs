@@ -64,7 +64,11 @@ pub fn mid_surface_quads(mesh: &Mesh) -> Vec<[usize; 4]> {
 /// `M` is a multiple of the identity and `h²` a sum of round-off-sized terms, where the
 /// discriminant of the quadratic would lose half the digits.
 pub fn principal_strains(big_g1: Vec3, big_g2: Vec3, g1: Vec3, g2: Vec3) -> (f64, f64) {
-    let (a11, a12, a22) = (big_g1.dot(&big_g1), big_g1.dot(&big_g2), big_g2.dot(&big_g2));
+    let (a11, a12, a22) = (
+        big_g1.dot(&big_g1),
+        big_g1.dot(&big_g2),
+        big_g2.dot(&big_g2),
+    );
     let (b11, b12, b22) = (g1.dot(&g1), g1.dot(&g2), g2.dot(&g2));
     let det = a11 * a22 - a12 * a12;
     // M = G⁻¹ g with G⁻¹ = [[a22, -a12], [-a12, a11]] / det.
@@ -88,8 +92,11 @@ pub fn column_strains(mesh: &Mesh, u: &[f64]) -> ColumnStrains {
     let cols = mesh.columns();
     let reference: Vec<Vec3> = cols.iter().map(|c| mid(c, false)).collect();
     let current: Vec<Vec3> = cols.iter().map(|c| mid(c, true)).collect();
-    let (mut major, mut minor, mut weight) =
-        (vec![0.0; cols.len()], vec![0.0; cols.len()], vec![0.0; cols.len()]);
+    let (mut major, mut minor, mut weight) = (
+        vec![0.0; cols.len()],
+        vec![0.0; cols.len()],
+        vec![0.0; cols.len()],
+    );
     for q in mid_surface_quads(mesh) {
         for k in 0..4 {
             let (a, b, d) = (q[k], q[(k + 1) % 4], q[(k + 3) % 4]);

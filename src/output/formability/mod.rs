@@ -127,7 +127,10 @@ pub fn fields(f: &Formability, node_count: usize, columns: &[Vec<usize>]) -> Vec
     if f.flc.is_some() {
         out.push(Field::scalar("flc_margin", per_node(&|c| f.margin[c])));
     }
-    out.push(Field::scalar("formability", per_node(&|c| f.zone[c].code() as f64)));
+    out.push(Field::scalar(
+        "formability",
+        per_node(&|c| f.zone[c].code() as f64),
+    ));
     out
 }
 
@@ -148,7 +151,9 @@ pub fn summary(sim: &Simulation, f: &Formability) -> serde_json::Value {
         })
     };
     let columns = 0..f.zone.len();
-    let thinnest = columns.clone().max_by(|&a, &b| f.thinning(a).total_cmp(&f.thinning(b)));
+    let thinnest = columns
+        .clone()
+        .max_by(|&a, &b| f.thinning(a).total_cmp(&f.thinning(b)));
     let tightest = (columns.clone())
         .filter(|&c| f.margin[c].is_finite())
         .min_by(|&a, &b| f.margin[a].total_cmp(&f.margin[b]));
@@ -175,7 +180,9 @@ pub fn summary(sim: &Simulation, f: &Formability) -> serde_json::Value {
 /// The end-of-run terminal lines: the largest thinning and the worst zone reached.
 pub fn terminal_lines(f: &Formability) -> Vec<String> {
     let columns = 0..f.zone.len();
-    let max_thinning = columns.map(|c| f.thinning(c)).fold(f64::NEG_INFINITY, f64::max);
+    let max_thinning = columns
+        .map(|c| f.thinning(c))
+        .fold(f64::NEG_INFINITY, f64::max);
     let worst = f.zone.iter().max().copied().unwrap_or(Zone::Safe);
     let count = f.zone.iter().filter(|&&z| z == worst).count();
     vec![
