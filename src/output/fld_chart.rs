@@ -8,9 +8,9 @@
 //! axes span the points and the curve's plane-strain intercept, so the curve is always in
 //! view. Size: one short `<circle>` per column (~60 bytes), ~160 kB for 2600 columns.
 
+use super::fmt_f64;
 use super::formability::{Flc, Formability, Zone};
-use super::svg::{axis, data_range, px, svg_open, text, write_pair, y_tick_label};
-use super::{fmt_f64, svg::tick_label};
+use super::svg::{axis, data_range, px, svg_open, text, write_pair, PlotFrame};
 use crate::Result;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -54,8 +54,15 @@ impl FldChart<'_> {
         let (y0, y1, yt, ys) = axis(y_lo, y_hi, 8);
         let (width, height) = (760.0, 560.0);
         let (left, right, top, bottom) = (80.0, width - 200.0, 62.0, height - 60.0);
-        let sx = |x: f64| left + (x - x0) / (x1 - x0) * (right - left);
-        let sy = |y: f64| bottom - (y - y0) / (y1 - y0) * (bottom - top);
+        let frame = PlotFrame {
+            left,
+            right,
+            top,
+            bottom,
+            x: (x0, x1),
+            y: (y0, y1),
+        };
+        let (sx, sy) = (|x: f64| frame.sx(x), |y: f64| frame.sy(y));
         let mut out = String::new();
         svg_open(&mut out, width, height);
         text(
@@ -76,71 +83,15 @@ impl FldChart<'_> {
             "",
             &self.subtitle,
         );
-        out.push_str("<g stroke=\"#e0e0e0\" stroke-width=\"1\">\n");
-        for &t in &xt {
-            let _ = writeln!(
-                out,
-                "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\"/>",
-                px(sx(t)),
-                px(top),
-                px(bottom)
-            );
-        }
-        for &t in &yt {
-            let _ = writeln!(
-                out,
-                "<line x1=\"{1}\" y1=\"{0}\" x2=\"{2}\" y2=\"{0}\"/>",
-                px(sy(t)),
-                px(left),
-                px(right)
-            );
-        }
-        out.push_str("</g>\n");
-        let _ =
-            writeln!(
-            out,
-            "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#333\"/>",
-            px(left), px(top), px(right - left), px(bottom - top)
-        );
-        for &t in &xt {
-            text(
-                &mut out,
-                sx(t),
-                bottom + 18.0,
-                12.0,
-                "middle",
-                "",
-                &tick_label(t, xs),
-            );
-        }
-        for &t in &yt {
-            y_tick_label(&mut out, left, sy(t), &tick_label(t, ys));
-        }
-        text(
+        frame.draw_axes(
             &mut out,
-            (left + right) / 2.0,
-            height - 18.0,
-            14.0,
-            "middle",
-            "",
+            (&xt, xs),
+            (&yt, ys),
+            height,
             "minor strain [%]",
-        );
-        let (lx, ly) = (22.0, (top + bottom) / 2.0);
-        let rotate = format!(" transform=\"rotate(-90 {} {})\"", px(lx), px(ly));
-        text(
-            &mut out,
-            lx,
-            ly,
-            14.0,
-            "middle",
-            &rotate,
             "major strain [%]",
         );
-        let _ = writeln!(
-            out,
-            "<clipPath id=\"plot\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath>\n<g clip-path=\"url(#plot)\">",
-            px(left), px(top), px(right - left), px(bottom - top)
-        );
+        frame.open_clipped(&mut out, "");
         for (k, z) in f.zone.iter().enumerate() {
             let _ = writeln!(
                 out,

@@ -1,7 +1,7 @@
 //! A line chart of x-y series as a standalone SVG, with its points as CSV beside it.
 
-use super::svg::{axis, data_range, px, svg_open, text, write_pair, y_tick_label, PALETTE};
-use super::{fmt_f64, svg::tick_label};
+use super::fmt_f64;
+use super::svg::{axis, data_range, px, svg_open, text, write_pair, PlotFrame, PALETTE};
 use crate::{Error, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -65,8 +65,15 @@ impl LineChart {
         );
         let (x0, x1, xt, xs) = axis_of(self.series.iter().flat_map(|s| s.x.iter().copied()));
         let (y0, y1, yt, ys) = axis_of(self.series.iter().flat_map(|s| s.y.iter().copied()));
-        let sx = |x: f64| left + (x - x0) / (x1 - x0) * (right - left);
-        let sy = |y: f64| bottom - (y - y0) / (y1 - y0) * (bottom - top);
+        let frame = PlotFrame {
+            left,
+            right,
+            top,
+            bottom,
+            x: (x0, x1),
+            y: (y0, y1),
+        };
+        let (sx, sy) = (|x: f64| frame.sx(x), |y: f64| frame.sy(y));
 
         let mut out = String::new();
         svg_open(&mut out, width, height);
@@ -79,70 +86,18 @@ impl LineChart {
             " font-weight=\"bold\"",
             &self.title,
         );
-        // Grid and ticks.
-        out.push_str("<g stroke=\"#e0e0e0\" stroke-width=\"1\">\n");
-        for &t in &xt {
-            let _ = writeln!(
-                out,
-                "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\"/>",
-                px(sx(t)),
-                px(top),
-                px(bottom)
-            );
-        }
-        for &t in &yt {
-            let _ = writeln!(
-                out,
-                "<line x1=\"{1}\" y1=\"{0}\" x2=\"{2}\" y2=\"{0}\"/>",
-                px(sy(t)),
-                px(left),
-                px(right)
-            );
-        }
-        out.push_str("</g>\n");
-        let _ = writeln!(
-            out,
-            "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#333\" stroke-width=\"1\"/>",
-            px(left), px(top), px(right - left), px(bottom - top)
-        );
-        for &t in &xt {
-            text(
-                &mut out,
-                sx(t),
-                bottom + 18.0,
-                12.0,
-                "middle",
-                "",
-                &tick_label(t, xs),
-            );
-        }
-        for &t in &yt {
-            y_tick_label(&mut out, left, sy(t), &tick_label(t, ys));
-        }
-        text(
+        frame.draw_axes(
             &mut out,
-            (left + right) / 2.0,
-            height - 18.0,
-            14.0,
-            "middle",
-            "",
+            (&xt, xs),
+            (&yt, ys),
+            height,
             &self.x_label,
-        );
-        let (lx, ly) = (22.0, (top + bottom) / 2.0);
-        text(
-            &mut out,
-            lx,
-            ly,
-            14.0,
-            "middle",
-            &format!(" transform=\"rotate(-90 {} {})\"", px(lx), px(ly)),
             &self.y_label,
         );
         // Series, clipped to the plot area.
-        let _ = writeln!(
-            out,
-            "<clipPath id=\"plot\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath>\n<g clip-path=\"url(#plot)\" fill=\"none\" stroke-width=\"2\" stroke-linejoin=\"round\">",
-            px(left), px(top), px(right - left), px(bottom - top)
+        frame.open_clipped(
+            &mut out,
+            " fill=\"none\" stroke-width=\"2\" stroke-linejoin=\"round\"",
         );
         for (i, s) in self.series.iter().enumerate() {
             let colour = PALETTE[i % PALETTE.len()];

@@ -174,6 +174,104 @@ pub(crate) fn y_tick_label(out: &mut String, x_axis: f64, y: f64, label: &str) {
     text(out, x_axis - 8.0, y + 4.0, 12.0, "end", "", label);
 }
 
+/// The plot area of an x-y chart: its pixel box and the data ranges it maps, so that a
+/// chart draws its grid, frame, tick labels and axis titles the same way as every other.
+pub(crate) struct PlotFrame {
+    pub left: f64,
+    pub right: f64,
+    pub top: f64,
+    pub bottom: f64,
+    /// Data ranges (x0, x1) and (y0, y1) mapped onto [left, right] and [bottom, top].
+    pub x: (f64, f64),
+    pub y: (f64, f64),
+}
+
+impl PlotFrame {
+    pub fn sx(&self, x: f64) -> f64 {
+        self.left + (x - self.x.0) / (self.x.1 - self.x.0) * (self.right - self.left)
+    }
+
+    pub fn sy(&self, y: f64) -> f64 {
+        self.bottom - (y - self.y.0) / (self.y.1 - self.y.0) * (self.bottom - self.top)
+    }
+
+    /// Grid lines at the ticks, the frame, tick labels (steps `xs`, `ys`) and the axis
+    /// titles (x below, y rotated at the left edge); `height` is the SVG's.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw_axes(
+        &self,
+        out: &mut String,
+        (xt, xs): (&[f64], f64),
+        (yt, ys): (&[f64], f64),
+        height: f64,
+        x_label: &str,
+        y_label: &str,
+    ) {
+        let (left, right, top, bottom) = (self.left, self.right, self.top, self.bottom);
+        out.push_str("<g stroke=\"#e0e0e0\" stroke-width=\"1\">\n");
+        for &t in xt {
+            let _ = writeln!(
+                out,
+                "<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\"/>",
+                px(self.sx(t)),
+                px(top),
+                px(bottom)
+            );
+        }
+        for &t in yt {
+            let _ = writeln!(
+                out,
+                "<line x1=\"{1}\" y1=\"{0}\" x2=\"{2}\" y2=\"{0}\"/>",
+                px(self.sy(t)),
+                px(left),
+                px(right)
+            );
+        }
+        out.push_str("</g>\n");
+        let _ = writeln!(
+            out,
+            "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#333\" stroke-width=\"1\"/>",
+            px(left), px(top), px(right - left), px(bottom - top)
+        );
+        for &t in xt {
+            text(
+                out,
+                self.sx(t),
+                bottom + 18.0,
+                12.0,
+                "middle",
+                "",
+                &tick_label(t, xs),
+            );
+        }
+        for &t in yt {
+            y_tick_label(out, left, self.sy(t), &tick_label(t, ys));
+        }
+        text(
+            out,
+            (left + right) / 2.0,
+            height - 18.0,
+            14.0,
+            "middle",
+            "",
+            x_label,
+        );
+        let (lx, ly) = (22.0, (top + bottom) / 2.0);
+        let rotate = format!(" transform=\"rotate(-90 {} {})\"", px(lx), px(ly));
+        text(out, lx, ly, 14.0, "middle", &rotate, y_label);
+    }
+
+    /// Opens a group clipped to the plot area (`attributes`: further attributes of the
+    /// group, each with a leading space); the caller closes it with `</g>`.
+    pub fn open_clipped(&self, out: &mut String, attributes: &str) {
+        let _ = writeln!(
+            out,
+            "<clipPath id=\"plot\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath>\n<g clip-path=\"url(#plot)\"{attributes}>",
+            px(self.left), px(self.top), px(self.right - self.left), px(self.bottom - self.top)
+        );
+    }
+}
+
 pub(crate) fn write_pair(svg_path: &Path, svg: &str, csv: &str) -> Result<PathBuf> {
     let csv_path = svg_path.with_extension("csv");
     if csv_path == svg_path {
