@@ -318,3 +318,60 @@ sim.chart_field("thinning.svg", "z+", "thinning");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Keeler-Brazier reads the thickness in mm (module doc of output::formability): a sheet
+/// modelled in metres with `units: #{ length: "m" }` gets the curve of its thickness in mm,
+/// the same curve as the same sheet in mm; a unit it cannot convert gives no curve, and
+/// summary.json says why.
+#[test]
+fn keeler_brazier_reads_the_thickness_in_the_scripts_length_unit() {
+    let dir = std::env::temp_dir().join(format!("tribo-flc-units-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |tag: &str, scale: f64, unit: &str| -> serde_json::Value {
+        let script = dir.join(format!("{tag}.rhai"));
+        let units = if unit.is_empty() {
+            String::new()
+        } else {
+            format!("units: #{{ length: \"{unit}\" }},")
+        };
+        std::fs::write(
+            &script,
+            format!(
+                r#"
+let s = {scale:?};
+let mesh = block([0.0, 0.0, 0.0], [10.0 * s, 10.0 * s, 0.8 * s], [2, 2, 1]);
+let sim = simulation(mesh, elastoplastic(210000.0, 0.3, von_mises(), swift(565.0, 0.007, 0.26)));
+sim.fix("x-", "x");
+sim.fix("y-", "y");
+sim.fix("z-", "z");
+sim.prescribe("x+", "x", [[0.0, 0.0], [1.0, 0.5 * s]]);
+sim.settings(#{{ end_time: 1.0, increments: 1, kinematics: "finite", {units} }});
+sim.run();
+"#
+            ),
+        )
+        .unwrap();
+        let out = dir.join(tag);
+        let host = tribo::script::HostOptions {
+            out_dir: out.clone(),
+            ..tribo::script::HostOptions::default()
+        };
+        tribo::script::run_file(&script, &[], &host).unwrap();
+        let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        serde_json::from_str::<serde_json::Value>(&text).unwrap()["formability"]["flc"].clone()
+    };
+    let mm = run("mm", 1.0, "");
+    let metres = run("m", 1e-3, "m");
+    assert_eq!(mm["kind"], "Keeler-Brazier (NADDRG)", "{mm}");
+    let t = |f: &serde_json::Value| f["thickness_mm"].as_f64().unwrap();
+    assert!((t(&mm) - 0.8).abs() < 1e-12, "{mm}");
+    assert!((t(&metres) - 0.8).abs() < 1e-12, "{metres}");
+    let flc0 = |f: &serde_json::Value| f["flc0_true"].as_f64().unwrap();
+    assert!((flc0(&mm) - flc0(&metres)).abs() < 1e-12);
+    let unknown = run("furlong", 1.0, "furlong");
+    assert_eq!(unknown["kind"], "none", "{unknown}");
+    let reason = unknown["reason"].as_str().unwrap();
+    assert!(reason.contains("'furlong'") && reason.contains("flc"), "{reason}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

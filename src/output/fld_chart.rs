@@ -35,6 +35,9 @@ impl FldChart<'_> {
     }
 
     /// The chart as an SVG document.
+    ///
+    /// A subtitle longer than [`SUBTITLE_CHARS`] is broken at its commas (a material's
+    /// description lists its constants so), so that it stays within the picture.
     pub fn to_svg(&self) -> String {
         let f = self.formability;
         let (minor, major) = (&f.columns.minor, &f.columns.major);
@@ -47,13 +50,15 @@ impl FldChart<'_> {
         x_hi = (x_hi + dx).max(10.0);
         y_lo = (y_lo - dy).min(0.0);
         y_hi += dy;
-        if let Some(flc) = &f.flc {
+        if let Ok(flc) = &f.flc {
             y_hi = y_hi.max(pct(flc.major_limit(0.0)) * 1.2);
         }
         let (x0, x1, xt, xs) = axis(x_lo, x_hi, 8);
         let (y0, y1, yt, ys) = axis(y_lo, y_hi, 8);
         let (width, height) = (760.0, 560.0);
-        let (left, right, top, bottom) = (80.0, width - 200.0, 62.0, height - 60.0);
+        let subtitle = wrap_at_commas(&self.subtitle, SUBTITLE_CHARS);
+        let top = 49.0 + 13.0 * subtitle.len() as f64;
+        let (left, right, bottom) = (80.0, width - 200.0, height - 60.0);
         let frame = PlotFrame {
             left,
             right,
@@ -74,15 +79,17 @@ impl FldChart<'_> {
             " font-weight=\"bold\"",
             &self.title,
         );
-        text(
-            &mut out,
-            (left + right) / 2.0,
-            46.0,
-            11.0,
-            "middle",
-            "",
-            &self.subtitle,
-        );
+        for (k, line) in subtitle.iter().enumerate() {
+            text(
+                &mut out,
+                (left + right) / 2.0,
+                44.0 + 13.0 * k as f64,
+                11.0,
+                "middle",
+                "",
+                line,
+            );
+        }
         frame.draw_axes(
             &mut out,
             (&xt, xs),
@@ -101,7 +108,7 @@ impl FldChart<'_> {
                 z.colour()
             );
         }
-        if let Some(flc) = &f.flc {
+        if let Ok(flc) = &f.flc {
             for (shift, dash) in [(0.0, ""), (self.safety_margin, " stroke-dasharray=\"6 4\"")] {
                 let pts: Vec<String> = Self::curve_points(flc, x0 / 100.0, x1 / 100.0, shift)
                     .iter()
@@ -187,8 +194,37 @@ impl FldChart<'_> {
     }
 }
 
+/// Characters of 11-pixel text that fit the FLD's width centred over its plot.
+const SUBTITLE_CHARS: usize = 100;
+
+/// `text` in lines of at most `width` characters, broken after commas (a part longer than
+/// `width` stays whole on its line).
+fn wrap_at_commas(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for part in text.split_inclusive(", ") {
+        match lines.last_mut() {
+            Some(line) if line.chars().count() + part.trim_end().chars().count() <= width => {
+                line.push_str(part)
+            }
+            _ => lines.push(part.to_string()),
+        }
+    }
+    lines.iter().map(|l| l.trim_end().to_string()).collect()
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn long_subtitles_break_at_commas_within_the_width() {
+        let text = "elastoplastic E=71000 nu=0.33, Hill48 F=0.5 G=0.5 H=0.5 L=1.5 M=1.5 N=1.5, \
+                    Swift C=576 eps0=0.01658 n=0.36";
+        let lines = super::wrap_at_commas(text, 60);
+        assert_eq!(lines.len(), 3, "{lines:?}");
+        assert!(lines.iter().all(|l| l.chars().count() <= 60), "{lines:?}");
+        assert_eq!(lines.join(" "), text);
+        assert_eq!(super::wrap_at_commas("short", 60), vec!["short"]);
+    }
+
     use super::*;
     use crate::output::formability::{ColumnStrains, Thresholds};
     use crate::output::svg::tests::assert_well_formed;
@@ -218,7 +254,7 @@ mod tests {
             })
             .collect();
         let f = Formability {
-            flc: Some(flc),
+            flc: Ok(flc),
             columns,
             margin,
             zone,

@@ -133,7 +133,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
             let mut range = Range::Data;
             for (key, v) in &options {
                 match key.as_str() {
-                    "title" => title = Some(string(v, "chart title")?),
+                    "title" => title = Some(string(&v, "chart title")?),
                     "label" => label = Some(string(v, "colour bar label")?),
                     "tool" => view.tool = Some(string(v, "tool")?),
                     "configuration" => {
@@ -199,10 +199,23 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     let h = host.clone();
     engine.register_fn(
         "chart_fld",
-        move |s: &mut ScriptSim, file: &str| -> ScriptResult<()> {
+        move |s: &mut ScriptSim, file: &str, options: Map| -> ScriptResult<()> {
+            let (mut title, mut subtitle) = (None, None);
+            for (k, v) in options {
+                match k.as_str() {
+                    "title" => title = Some(string(&v, "chart title")?),
+                    "subtitle" => subtitle = Some(string(&v, "chart subtitle")?),
+                    other => {
+                        return runtime_error(format!(
+                            "unknown chart_fld option '{other}' (known: title, subtitle)"
+                        ))
+                    }
+                }
+            }
             let path = chart_path(&h, file)?;
             let mut st = s.borrow_mut();
             let options = st.formability();
+            let time_unit = st.time_unit();
             let sim = st.simulation()?;
             let Some(f) = crate::output::formability::evaluate(sim, &options) else {
                 return runtime_error(
@@ -210,16 +223,25 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                      forming limit diagram",
                 );
             };
+            let unit = if time_unit.is_empty() { String::new() } else { format!(" {time_unit}") };
             let chart = crate::output::fld_chart::FldChart {
-                title: format!(
-                    "Forming limit diagram, t = {}",
-                    crate::output::significant(sim.time(), 6)
-                ),
-                subtitle: sim.model.material.describe(),
+                title: title.unwrap_or_else(|| {
+                    format!(
+                        "Forming limit diagram, t = {}{unit}",
+                        crate::output::significant(sim.time(), 6)
+                    )
+                }),
+                subtitle: subtitle.unwrap_or_else(|| sim.model.material.describe()),
                 formability: &f,
                 safety_margin: options.thresholds.safety_margin,
             };
             lift(chart.write(&path).map(|_| ()))
+        },
+    );
+    engine.register_fn(
+        "chart_fld",
+        |ctx: rhai::NativeCallContext, s: &mut ScriptSim, file: &str| -> ScriptResult<()> {
+            ctx.call_native_fn("chart_fld", (s.clone(), file.to_string(), Map::new()))
         },
     );
     engine.register_fn(

@@ -441,6 +441,11 @@ impl SimState {
         self.frames.units.length.clone()
     }
 
+    /// The pseudo-time unit named in the output settings ("" when none was set).
+    pub(super) fn time_unit(&self) -> String {
+        self.frames.units.time.clone()
+    }
+
     /// What the script keeps (`sim.keep`), as checkpoints store it.
     pub(super) fn keep(&mut self, name: &str, value: serde_json::Value) {
         self.kept.insert(name.to_string(), value);

@@ -139,7 +139,9 @@ pub(super) const SETTINGS: &[Setting] = &[
         Ok(())
     }),
     setting("units", "#{ length: \"mm\" }", |_, k, v| {
-        units(v.v, &mut k.frames.units)
+        units(v.v, &mut k.frames.units)?;
+        k.frames.formability.length_unit = k.frames.units.length.clone();
+        Ok(())
     }),
     setting("model_fraction", "0.25", |_, k, v| {
         let f = v.number()?;

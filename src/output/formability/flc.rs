@@ -52,6 +52,20 @@ pub enum Flc {
 }
 
 impl Flc {
+    /// Millimetres per length unit of the script's `units.length` (`""`, the default, is
+    /// mm: the engine is unit-free and its shipped models are in mm), for the Keeler-Brazier
+    /// curve's thickness, which its authors fitted in mm; None for a name not listed here.
+    pub fn millimetres_per(unit: &str) -> Option<f64> {
+        match unit.trim() {
+            "" | "mm" => Some(1.0),
+            "m" => Some(1000.0),
+            "cm" => Some(10.0),
+            "um" | "µm" | "micron" => Some(1e-3),
+            "in" | "inch" => Some(25.4),
+            _ => None,
+        }
+    }
+
     /// The Keeler-Brazier curve; `n >= 0` and `thickness_mm > 0`, both finite.
     pub fn keeler_brazier(n: f64, thickness_mm: f64) -> Result<Flc> {
         if !(n.is_finite() && n >= 0.0) {

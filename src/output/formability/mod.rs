@@ -14,9 +14,10 @@
 //! columns has none of these fields.
 //!
 //! The curve is the script's table (setting `flc`), else Keeler-Brazier from the material's
-//! Swift exponent and the mean initial thickness of the columns, read in mm (the engine is
-//! unit-free: a model in other length units gives a table); without either there is no
-//! curve, no `flc_margin`, and no crack or risk zone.
+//! Swift exponent and the mean initial thickness of the columns, converted to mm from the
+//! script's `units.length` (m, cm, mm, um, in; none set: mm); a model in a unit not listed
+//! gives a table. Without a curve there is no `flc_margin` and no crack or risk zone, and
+//! summary.json's `flc` says why.
 
 mod flc;
 mod mid_surface;
@@ -33,12 +34,15 @@ use crate::solver::Simulation;
 pub struct FormabilityOptions {
     pub flc: Option<Flc>,
     pub thresholds: Thresholds,
+    /// The script's length unit (`units.length`, "" when none was set: mm).
+    pub length_unit: String,
 }
 
 /// The formability of every column and its nodes.
 #[derive(Clone, Debug)]
 pub struct Formability {
-    pub flc: Option<Flc>,
+    /// The curve, or why there is none.
+    pub flc: std::result::Result<Flc, String>,
     pub columns: ColumnStrains,
     /// Per column: margin (NaN without a curve) and zone.
     pub margin: Vec<f64>,
@@ -62,19 +66,28 @@ impl Formability {
     }
 }
 
-/// The curve a run uses (module doc); an invalid Keeler-Brazier input gives none.
-pub fn curve(sim: &Simulation, options: &FormabilityOptions) -> Option<Flc> {
+/// The curve a run uses (module doc), or why there is none.
+pub fn curve(sim: &Simulation, options: &FormabilityOptions) -> std::result::Result<Flc, String> {
     if let Some(flc) = &options.flc {
-        return Some(flc.clone());
+        return Ok(flc.clone());
     }
-    let n = sim.model.material.hardening_exponent()?;
+    let n = (sim.model.material.hardening_exponent()).ok_or_else(|| {
+        "no curve: the material has no Swift law for Keeler-Brazier; give the setting flc".to_string()
+    })?;
+    let mm = Flc::millimetres_per(&options.length_unit).ok_or_else(|| {
+        format!(
+            "no curve: Keeler-Brazier needs the thickness in mm and the length unit '{}' is \
+             not one of m, cm, mm, um, in; give the setting flc",
+            options.length_unit
+        )
+    })?;
     let mesh = &sim.model.mesh;
     let t0 = mesh.column_thicknesses(|_| crate::geometry::Vec3::zeros());
     if t0.is_empty() {
-        return None;
+        return Err("no curve: the mesh has no through-thickness columns".into());
     }
     let mean = t0.iter().sum::<f64>() / t0.len() as f64;
-    Flc::keeler_brazier(n, mean).ok()
+    Flc::keeler_brazier(n, mean * mm).map_err(|e| format!("no curve: {e}"))
 }
 
 /// The formability of the committed state, None for a mesh without columns.
@@ -93,7 +106,7 @@ pub fn evaluate(sim: &Simulation, options: &FormabilityOptions) -> Option<Formab
     };
     for c in 0..out.columns.major.len() {
         let (major, minor) = (out.columns.major[c], out.columns.minor[c]);
-        let margin = out.flc.as_ref().map(|f| f.margin(major, minor));
+        let margin = out.flc.as_ref().ok().map(|f| f.margin(major, minor));
         let point = SheetPoint {
             major,
             minor,
@@ -124,7 +137,7 @@ pub fn fields(f: &Formability, node_count: usize, columns: &[Vec<usize>]) -> Vec
         Field::scalar("minor_strain", per_node(&|c| f.columns.minor[c])),
         Field::scalar("strain_ratio", per_node(&|c| f.strain_ratio(c))),
     ];
-    if f.flc.is_some() {
+    if f.flc.is_ok() {
         out.push(Field::scalar("flc_margin", per_node(&|c| f.margin[c])));
     }
     out.push(Field::scalar(
@@ -173,7 +186,10 @@ pub fn summary(sim: &Simulation, f: &Formability) -> serde_json::Value {
         "min_flc_margin_at": tightest.map(place),
         "nodes_per_zone": counts,
         "worst_zone": worst.name(),
-        "flc": f.flc.as_ref().map(Flc::describe),
+        "flc": match &f.flc {
+            Ok(flc) => flc.describe(),
+            Err(why) => serde_json::json!({ "kind": "none", "reason": why }),
+        },
     })
 }
 
