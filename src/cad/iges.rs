@@ -572,6 +572,7 @@ impl<'a> Iges<'a> {
                         origin: Self::describe(e),
                         flip: false,
                         arcs,
+                        names: Vec::new(),
                     });
                 }
                 108 | 190 if !used.contains(&pointer) => faces.push(self.bounded_plane(e)?),
@@ -716,6 +717,7 @@ impl<'a> Iges<'a> {
             origin: Self::describe(e),
             flip: false,
             arcs,
+            names: Vec::new(),
         })
     }
 
