@@ -42,7 +42,12 @@ fn z_range(face: &Face) -> (f64, f64) {
 /// 1e-6 of the box: ~1e-12 relative), independently of the library's own.
 fn centre_normal(face: &Face) -> Vec3 {
     let [[u0, u1], [v0, v1]] = face.surface.domain();
-    let (u, v, hu, hv) = (0.5 * (u0 + u1), 0.5 * (v0 + v1), 1e-6 * (u1 - u0), 1e-6 * (v1 - v0));
+    let (u, v, hu, hv) = (
+        0.5 * (u0 + u1),
+        0.5 * (v0 + v1),
+        1e-6 * (u1 - u0),
+        1e-6 * (v1 - v0),
+    );
     let su = face.surface.point(u + hu, v) - face.surface.point(u - hu, v);
     let sv = face.surface.point(u, v + hv) - face.surface.point(u, v - hv);
     let n = su.cross(&sv).normalize();
@@ -71,14 +76,21 @@ fn the_die_faces_facing_up_are_its_top_and_entry_radius() {
     let top = choose([0.0, 0.0, 1.0], 10.0, false);
     assert_eq!(top.len(), 1);
     let (lo, hi) = z_range(&top[0]);
-    assert!(lo.abs() < 1e-12 && hi.abs() < 1e-12, "top at z = 0: {lo} {hi}");
+    assert!(
+        lo.abs() < 1e-12 && hi.abs() < 1e-12,
+        "top at z = 0: {lo} {hi}"
+    );
     assert!((centre_normal(&top[0]) - Vec3::z()).norm() < 1e-9);
 
     let up = choose([0.0, 0.0, 1.0], 90.0, false);
     assert_eq!(up.len(), 9);
     for f in &up {
         let (lo, hi) = z_range(f);
-        assert!(lo > -8.0 - 1e-9 && hi < 1e-9, "{}: z in [{lo}, {hi}]", f.origin);
+        assert!(
+            lo > -8.0 - 1e-9 && hi < 1e-9,
+            "{}: z in [{lo}, {hi}]",
+            f.origin
+        );
         assert!(centre_normal(f).z > 0.5, "{}", f.origin);
     }
     // The 13 others face sideways or down at their centres.
@@ -90,14 +102,22 @@ fn the_die_faces_facing_up_are_its_top_and_entry_radius() {
     let flipped = choose([0.0, 0.0, 1.0], 10.0, true);
     assert_eq!(flipped.len(), 1);
     let (lo, hi) = z_range(&flipped[0]);
-    assert!((lo + 58.0).abs() < 1e-9 && (hi + 58.0).abs() < 1e-9, "bottom: {lo} {hi}");
+    assert!(
+        (lo + 58.0).abs() < 1e-9 && (hi + 58.0).abs() < 1e-9,
+        "bottom: {lo} {hi}"
+    );
     // Nothing faces +x and -z at once within 10 degrees: a clear error.
     let options = ImportOptions {
         facing: facing([1.0, 0.0, -1.0], 10.0),
         ..ImportOptions::default()
     };
-    let e = choose_faces("die", die(), &options).unwrap_err().to_string();
-    assert!(e.contains("none of the 22 faces") && e.contains("10 degrees"), "{e}");
+    let e = choose_faces("die", die(), &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("none of the 22 faces") && e.contains("10 degrees"),
+        "{e}"
+    );
     assert!(Facing::new(Vec3::zeros(), 10.0, "f").is_err());
     assert!(Facing::new(Vec3::z(), 0.0, "f").is_err());
 }
@@ -129,7 +149,9 @@ fn faces_are_chosen_by_their_own_or_their_solid_name() {
         names: Some(vec!["top".into()]),
         ..ImportOptions::default()
     };
-    let e = choose_faces("die", die(), &options).unwrap_err().to_string();
+    let e = choose_faces("die", die(), &options)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("names none"), "{e}");
 }
 
@@ -143,7 +165,9 @@ fn an_oriented_face_with_orientation_false_reverses_the_normal() {
     let with = |flag: &str| {
         let edited = original.replace(
             "#16 = OPEN_SHELL('',(#17));",
-            &format!("#16 = OPEN_SHELL('sheet',(#9000));\n#9000 = ORIENTED_FACE('o',*,#17,{flag});"),
+            &format!(
+                "#16 = OPEN_SHELL('sheet',(#9000));\n#9000 = ORIENTED_FACE('o',*,#17,{flag});"
+            ),
         );
         let faces = faces_from_step("oriented.step", &edited).unwrap();
         assert_eq!(faces.len(), 1);

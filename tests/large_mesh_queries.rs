@@ -91,7 +91,8 @@ let top = sim.contact_node("floor", 31);
     let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
     let error = summary["error"].as_str().expect("the error is recorded");
     assert!(
-        error.contains("node 31 is not a contact candidate") && error.contains("after_run.rhai:11:"),
+        error.contains("node 31 is not a contact candidate")
+            && error.contains("after_run.rhai:11:"),
         "the failed call and its line: {error}"
     );
     assert_eq!(summary["increments"], 4);
@@ -99,7 +100,7 @@ let top = sim.contact_node("floor", 31);
     assert_eq!(summary["slipping"], 16, "the script's entry kept");
     let ck = out.join("checkpoints/final.json");
     let text = std::fs::read_to_string(&ck).expect("checkpoints/final.json");
-    let ck = tribo::solver::simulation::checkpoint::Checkpoint::from_json(&text, "final.json")
-        .unwrap();
+    let ck =
+        tribo::solver::simulation::checkpoint::Checkpoint::from_json(&text, "final.json").unwrap();
     assert_eq!(ck.history.len(), 4);
 }

@@ -106,7 +106,10 @@ pub fn choose_faces(source: &str, faces: Vec<Face>, options: &ImportOptions) -> 
 }
 
 fn no_such_name(source: &str, name: &str, faces: &[Face]) -> Error {
-    let mut known: Vec<&str> = faces.iter().flat_map(|f| f.names.iter().map(String::as_str)).collect();
+    let mut known: Vec<&str> = faces
+        .iter()
+        .flat_map(|f| f.names.iter().map(String::as_str))
+        .collect();
     known.sort_unstable();
     known.dedup();
     let have = if known.is_empty() {
@@ -116,5 +119,7 @@ fn no_such_name(source: &str, name: &str, faces: &[Face]) -> Error {
     } else {
         format!("the names there are: {}", known.join(", "))
     };
-    Error::Input(format!("{source}: no face answers to the name '{name}'; {have}"))
+    Error::Input(format!(
+        "{source}: no face answers to the name '{name}'; {have}"
+    ))
 }

@@ -83,7 +83,9 @@ impl Step<'_> {
                         .collect::<Result<_>>()?,
                     _ => continue,
                 };
-                let Some(name) = text(p.first()) else { continue };
+                let Some(name) = text(p.first()) else {
+                    continue;
+                };
                 for s in shells {
                     for &f in shell_faces.get(&s).map_or(&[][..], |v| &v[..]) {
                         ctx.entry(f).or_default().names.push(name.clone());

@@ -44,7 +44,9 @@ fn options(map: &Map, function: &str) -> ScriptResult<ImportOptions> {
                 let a = value
                     .clone()
                     .try_cast::<Array>()
-                    .ok_or_else(|| format!("{function} option facing must be a direction [x, y, z]"))
+                    .ok_or_else(|| {
+                        format!("{function} option facing must be a direction [x, y, z]")
+                    })
                     .or_else(runtime_error)?;
                 facing = Some(vec3(&a, &format!("{function} option facing"))?);
             }
@@ -95,9 +97,19 @@ fn names(value: &rhai::Dynamic, function: &str) -> ScriptResult<Vec<String>> {
         return Ok(vec![value.to_string()]);
     }
     let bad = || format!("{function} option names must be a string or an array of strings");
-    let list = value.clone().try_cast::<Array>().ok_or_else(bad).or_else(runtime_error)?;
+    let list = value
+        .clone()
+        .try_cast::<Array>()
+        .ok_or_else(bad)
+        .or_else(runtime_error)?;
     list.iter()
-        .map(|n| if n.is_string() { Ok(n.to_string()) } else { runtime_error(bad()) })
+        .map(|n| {
+            if n.is_string() {
+                Ok(n.to_string())
+            } else {
+                runtime_error(bad())
+            }
+        })
         .collect()
 }
 

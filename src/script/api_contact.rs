@@ -143,7 +143,10 @@ fn candidates(s: &mut ScriptSim, name: &str) -> ScriptResult<Vec<ContactNode>> {
 
 /// One [`ContactNode`] per candidate node of a tool.
 fn contact_nodes(s: &mut ScriptSim, name: &str) -> ScriptResult<Array> {
-    Ok(candidates(s, name)?.into_iter().map(Dynamic::from).collect())
+    Ok(candidates(s, name)?
+        .into_iter()
+        .map(Dynamic::from)
+        .collect())
 }
 
 /// A node's history against a tool: one map per converged increment.
