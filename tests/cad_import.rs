@@ -242,6 +242,7 @@ fn flip_reverses_normals_and_gaps() {
             translate: Vec3::new(0.0, 0.0, 0.81),
             faces: None,
             flip: false,
+            ..Default::default()
         },
     );
     let p = moved.project(&Vec3::new(1.0, 2.0, -1.0), None).unwrap();
@@ -362,6 +363,20 @@ fn bad_files_are_refused_naming_what_and_where() {
             d + 1,
             d + 1
         )) && e.contains("BRepBuilderAPI_NurbsConvert"),
+        "{e}"
+    );
+    // A file in BRep mode (issue 49): its first BRep entity is named with the fix, not a
+    // surface of its faces (the directory entry alone makes it one: a 510 face).
+    let d510 = lines[d].replacen("     120", "     510", 1);
+    let mut brep = lines.clone();
+    brep[d] = &d510;
+    let e = refusal("brep.igs", &brep.join("\n"));
+    assert!(
+        e.contains(&format!(
+            "brep.igs:{}: entity 510 (face) at D line {}: IGES BRep",
+            d + 1,
+            d + 1
+        )) && e.contains("faces mode"),
         "{e}"
     );
     // Not IGES at all.

@@ -21,6 +21,9 @@ fn scripts_read_cad_tools_with_options() {
         let die = tool_from_step("{dir}/die_nurbs.step").seam_report();
         // Faces meet without gaps; the sharpest kink is the block's square outer edge.
         if die.worst_gap > 1e-9 || (die.worst_kink_deg - 90.0).abs() > 1e-6 {{ throw `die seams ${{die}}`; }}
+        // The die's faces facing up within 10 degrees: its top, one plane patch.
+        let top = tool_from_step("{dir}/die_analytic.step", #{{ facing: [0, 0, 1], facing_angle: 10 }}).seam_report();
+        if top.patches != 1 {{ throw `top ${{top}}`; }}
         let one = tool_from_nurbs_json("plate.json", #{{ flip: false }}).seam_report();
         if one.patches != 1 {{ throw "plate"; }}
         "#
@@ -49,7 +52,7 @@ fn scripts_get_the_file_line_and_entity_of_a_refusal() {
     let cases = [
         (
             format!("tool_from_iges(\"{dir}/punch_nurbs.igs\", #{{ flop: true }});"),
-            "tool_from_iges option 'flop' is unknown; expected faces, flip, translate".to_string(),
+            "tool_from_iges option 'flop' is unknown; expected faces, names, facing, facing_angle, flip, translate".to_string(),
         ),
         (
             format!("tool_from_step(\"{dir}/die_nurbs.step\", #{{ faces: [999] }});"),

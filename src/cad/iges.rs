@@ -544,6 +544,7 @@ impl<'a> Iges<'a> {
 
     /// The faces: 144 entities, and 128 entities that no 144 or 142 uses.
     fn faces(&self) -> Result<Vec<Face>> {
+        self.refuse_brep()?;
         let mut used = HashSet::new();
         for e in &self.entries {
             if e.kind == 144 || e.kind == 142 {
@@ -572,6 +573,7 @@ impl<'a> Iges<'a> {
                         origin: Self::describe(e),
                         flip: false,
                         arcs,
+                        names: Vec::new(),
                     });
                 }
                 108 | 190 if !used.contains(&pointer) => faces.push(self.bounded_plane(e)?),
@@ -588,6 +590,28 @@ impl<'a> Iges<'a> {
             )));
         }
         Ok(faces)
+    }
+
+    /// A file in BRep mode (186 solids, 514 shells, 510 faces) is refused as a whole,
+    /// naming its first BRep entity: its faces' surfaces (190-198 among them) are bounded by
+    /// the 508 loops, which are not read, so any other message would blame a surface.
+    fn refuse_brep(&self) -> Result<()> {
+        match self
+            .entries
+            .iter()
+            .find(|e| matches!(e.kind, 186 | 514 | 510))
+        {
+            Some(e) => Err(Error::Input(format!(
+                "{}:{}: {}: IGES BRep (186 solid, 514 shell, 510 face, 508 loop, 504 edge, \
+                 502 vertex) is not read; write the IGES in faces mode (144 trimmed \
+                 surfaces; OpenCascade: write.iges.brep.mode = 0, its default), or export \
+                 STEP, whose analytic faces are read",
+                self.source,
+                e.file_line,
+                Self::describe(e)
+            ))),
+            None => Ok(()),
+        }
     }
 
     fn unread_surface(&self, e: &Entry) -> Error {
@@ -716,6 +740,7 @@ impl<'a> Iges<'a> {
             origin: Self::describe(e),
             flip: false,
             arcs,
+            names: Vec::new(),
         })
     }
 

@@ -328,6 +328,7 @@ impl Iges<'_> {
             origin: Self::describe(s),
             flip: false,
             arcs: [None, None],
+            names: Vec::new(),
         })
     }
 }

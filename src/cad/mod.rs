@@ -9,10 +9,12 @@
 pub mod iges;
 mod iges_analytic;
 pub mod nurbs_json;
+mod select;
 pub mod step;
 mod step_analytic;
 mod step_assembly;
 mod step_curves;
+mod step_topology;
 
 use crate::geometry::nurbs::NurbsSurface;
 use crate::geometry::trim::{PieceTrim, TrimRegion};
@@ -36,6 +38,9 @@ pub struct Face {
     /// angle, as on an IGES surface of revolution; `None`: the trim uses the surface's own
     /// parameter.
     pub arcs: [Option<f64>; 2],
+    /// The names the face answers to (a STEP face's own, its shell's and solid's: see
+    /// `step_topology.rs`); empty for IGES and JSON faces.
+    pub names: Vec<String>,
 }
 
 /// What to make of the faces of a file.
@@ -43,11 +48,17 @@ pub struct Face {
 pub struct ImportOptions {
     /// Indices (in file order, from 0) of the faces to keep; `None`: all.
     pub faces: Option<Vec<usize>>,
+    /// Keep the faces answering to one of these names ([`Face::names`]); `None`: all.
+    pub names: Option<Vec<String>>,
+    /// Keep the faces whose normal at their centre points within this cone ([`Facing`]).
+    pub facing: Option<Facing>,
     /// Reverse every face's normal (a tool whose faces point into it).
     pub flip: bool,
     /// Moved by this after reading (mm).
     pub translate: Vec3,
 }
+
+pub use select::{choose_faces, Facing};
 
 /// The tool surface of the chosen faces (see the module docs). Errs naming the face whose
 /// surface is degenerate, and as [`PatchSurface::with_trims`] for inconsistent normals.
@@ -56,23 +67,7 @@ pub fn tool_surface(
     faces: Vec<Face>,
     options: &ImportOptions,
 ) -> Result<PatchSurface> {
-    let chosen: Vec<Face> = match &options.faces {
-        None => faces,
-        Some(list) => {
-            let mut out = Vec::with_capacity(list.len());
-            for &k in list {
-                let face = faces.get(k).ok_or_else(|| {
-                    Error::input(
-                        &format!("{source}: face index"),
-                        k,
-                        &format!("must be < the file's face count {}", faces.len()),
-                    )
-                })?;
-                out.push(face.clone());
-            }
-            out
-        }
-    };
+    let chosen = choose_faces(source, faces, options)?;
     if chosen.is_empty() {
         return Err(Error::Input(format!("{source}: no face to make a tool of")));
     }

@@ -164,6 +164,7 @@ fn face(v: &Value, name: &str) -> Result<Face> {
         origin: name.to_string(),
         flip: false,
         arcs: [None, None],
+        names: Vec::new(),
     })
 }
 

@@ -22,7 +22,10 @@
 //! and on a periodic surface a turn either side) searched depth first for a closed chain,
 //! so a loop needs only its pcurves, not the orientation flags. A face's outward normal is
 //! its surface's `S_u x S_v` if its `same_sense` is true, the opposite otherwise (a face of
-//! a closed shell or solid then points out of it, as OpenCascade writes them).
+//! a closed shell or solid then points out of it, as OpenCascade writes them), reversed
+//! again where its shell lists it through an `ORIENTED_FACE` with orientation `.F.`; the
+//! names a face answers to (its own, its shell's, its solid's) are gathered by
+//! [`super::step_topology`] for choosing faces by name.
 //! Parts placed in an assembly (`CONTEXT_DEPENDENT_SHAPE_REPRESENTATION` with an
 //! `ITEM_DEFINED_TRANSFORMATION`) come out at their placed pose ([`super::step_assembly`]). Every error names the file, the line
 //! and the instance (`#id`); the file's text is never echoed.
@@ -898,6 +901,7 @@ impl<'a> Step<'a> {
 
     fn faces(&self) -> Result<Vec<Face>> {
         let placements = self.face_placements()?;
+        let contexts = self.face_contexts()?;
         let mut faces = Vec::new();
         for (&id, inst) in &self.instances {
             let Some((_, p)) = inst.parts.iter().find(|(n, _)| n == "ADVANCED_FACE") else {
@@ -928,13 +932,17 @@ impl<'a> Step<'a> {
             };
             let identity = [(crate::geometry::Mat3::identity(), Vec3::zeros())];
             let poses = placements.get(&id).map_or(&identity[..], |p| &p[..]);
+            let context = contexts.get(&id).cloned().unwrap_or_default();
             for (r, t) in poses {
                 faces.push(Face {
                     surface: surface.clone().transformed(r, &(t * self.to_mm)),
                     trim: trim.clone(),
                     origin: format!("#{id} (ADVANCED_FACE) at line {}", inst.line),
-                    flip: !same_sense,
+                    // n = s o (S_u x S_v) (step_topology.rs): flipped when exactly one of
+                    // same_sense and the shell's orientation is false.
+                    flip: !same_sense != context.reversed,
                     arcs,
+                    names: context.names.clone(),
                 });
             }
         }

@@ -1,4 +1,5 @@
-//! Gmsh MSH 4.1 meshes (ASCII and binary), parsed by the `mshio` crate.
+//! Gmsh MSH 4.1 meshes (ASCII and binary), parsed by the `mshio` crate; MSH 2.2 (ASCII and
+//! binary), which `mshio` does not read, by `gmsh22.rs` into the same structure.
 //!
 //! Kept: 8-node hexahedra (Gmsh type 5, whose node order is tribo's VTK order). Physical
 //! groups become named sets: every group is a node set (the nodes of its elements), a
@@ -20,8 +21,11 @@ use crate::geometry::Vec3;
 use crate::{Error, Result};
 use mshio::ElementType;
 
-/// Reads a Gmsh MSH 4.1 file from its bytes; `file` names it in messages.
+/// Reads a Gmsh MSH 4.1 or 2.2 file from its bytes; `file` names it in messages.
 pub fn read_gmsh(bytes: &[u8], file: &str) -> Result<Mesh> {
+    if is_version_2(bytes) {
+        return super::gmsh22::read_msh22(bytes, file)?.build(file);
+    }
     let ascii = is_ascii_format(bytes);
     let msh = mshio::parse_msh_bytes(bytes).map_err(|e| parse_error(&e, bytes, file, ascii))?;
     let names = physical_names(bytes, file)?;
@@ -105,7 +109,7 @@ fn entity_physical_tags(msh: &mshio::MshFile<u64, i32, f64>) -> HashMap<(i32, i3
 
 /// The set name of physical group `tag` (of dimension `dim`; a negative tag, an oriented
 /// reference, names the same group): its `$PhysicalNames` name, or `"physical <tag>"`.
-fn group_name(names: &BTreeMap<(i32, i32), String>, dim: i32, tag: i32) -> String {
+pub(super) fn group_name(names: &BTreeMap<(i32, i32), String>, dim: i32, tag: i32) -> String {
     names
         .get(&(dim, tag.abs()))
         .cloned()
@@ -249,6 +253,17 @@ fn add_group_elements(
     Ok(())
 }
 
+/// Whether the `$MeshFormat` header's version is 2.x.
+fn is_version_2(bytes: &[u8]) -> bool {
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(64)]);
+    let mut lines = head.lines();
+    lines.next().map(str::trim) == Some("$MeshFormat")
+        && lines
+            .next()
+            .and_then(|l| l.split_whitespace().next())
+            .is_some_and(|v| v.starts_with("2."))
+}
+
 /// Whether the `$MeshFormat` header says ASCII (file-type 0).
 fn is_ascii_format(bytes: &[u8]) -> bool {
     let head = String::from_utf8_lossy(&bytes[..bytes.len().min(64)]);
@@ -259,7 +274,7 @@ fn is_ascii_format(bytes: &[u8]) -> bool {
 }
 
 /// 1-based line of byte `at`.
-fn line_of(bytes: &[u8], at: usize) -> usize {
+pub(super) fn line_of(bytes: &[u8], at: usize) -> usize {
     1 + bytes[..at.min(bytes.len())]
         .iter()
         .filter(|&&b| b == b'\n')
@@ -267,7 +282,7 @@ fn line_of(bytes: &[u8], at: usize) -> usize {
 }
 
 /// `$PhysicalNames` (ASCII in both formats): (dim, tag) -> name.
-fn physical_names(bytes: &[u8], file: &str) -> Result<BTreeMap<(i32, i32), String>> {
+pub(super) fn physical_names(bytes: &[u8], file: &str) -> Result<BTreeMap<(i32, i32), String>> {
     let mut names = BTreeMap::new();
     let Some(start) = find(bytes, b"$PhysicalNames") else {
         return Ok(names);
@@ -296,7 +311,7 @@ fn physical_names(bytes: &[u8], file: &str) -> Result<BTreeMap<(i32, i32), Strin
     Ok(names)
 }
 
-fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+pub(super) fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
     hay.windows(needle.len()).position(|w| w == needle)
 }
 
@@ -403,7 +418,8 @@ mod tests {
             .to_string();
         assert!(e.contains(&format!("bad.msh:{}", line + 4)), "{e}");
 
-        let e = read_gmsh(b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", "old.msh")
+        // MSH 2 is read by gmsh22.rs; a version neither 2 nor 4.1 is refused.
+        let e = read_gmsh(b"$MeshFormat\n3.0 0 8\n$EndMeshFormat\n", "old.msh")
             .unwrap_err()
             .to_string();
         assert!(e.contains("old.msh:") && e.contains("4.1"), "{e}");

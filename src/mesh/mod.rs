@@ -35,6 +35,7 @@ mod block;
 mod columns;
 mod faces;
 pub mod gmsh;
+mod gmsh22;
 mod grading;
 mod import;
 pub mod inp;

@@ -10,9 +10,12 @@ use rhai::{Array, Engine, Map};
 use std::rc::Rc;
 use std::sync::Arc;
 
-/// `#{ faces: [0, 3], flip: false, translate: [0, 0, 0.81] }`, every key optional.
+/// `#{ faces: [0, 3], names: ["top"], facing: [0, 0, 1], facing_angle: 30, flip: false,
+/// translate: [0, 0, 0.81] }`, every key optional.
 fn options(map: &Map, function: &str) -> ScriptResult<ImportOptions> {
     let mut out = ImportOptions::default();
+    let mut facing: Option<crate::geometry::Vec3> = None;
+    let mut facing_angle: Option<f64> = None;
     for (key, value) in map {
         match key.as_str() {
             "faces" => {
@@ -36,6 +39,20 @@ fn options(map: &Map, function: &str) -> ScriptResult<ImportOptions> {
                 }
                 out.faces = Some(faces);
             }
+            "names" => out.names = Some(names(value, function)?),
+            "facing" => {
+                let a = value
+                    .clone()
+                    .try_cast::<Array>()
+                    .ok_or_else(|| {
+                        format!("{function} option facing must be a direction [x, y, z]")
+                    })
+                    .or_else(runtime_error)?;
+                facing = Some(vec3(&a, &format!("{function} option facing"))?);
+            }
+            "facing_angle" => {
+                facing_angle = Some(number(value, &format!("{function} option facing_angle"))?)
+            }
             "flip" => {
                 out.flip = value.as_bool().or_else(|_| {
                     runtime_error(format!("{function} option flip must be true or false"))
@@ -51,12 +68,49 @@ fn options(map: &Map, function: &str) -> ScriptResult<ImportOptions> {
             }
             other => {
                 return runtime_error(format!(
-                    "{function} option '{other}' is unknown; expected faces, flip, translate"
+                    "{function} option '{other}' is unknown; expected faces, names, facing, \
+                     facing_angle, flip, translate"
                 ))
             }
         }
     }
+    out.facing = match (facing, facing_angle) {
+        // Default 90 degrees: n . d > 0, the faces seen from the side d points to.
+        (Some(d), angle) => Some(lift(crate::cad::Facing::new(
+            d,
+            angle.unwrap_or(90.0),
+            &format!("{function} option facing"),
+        ))?),
+        (None, Some(_)) => {
+            return runtime_error(format!(
+                "{function} option facing_angle needs the option facing (a direction)"
+            ))
+        }
+        (None, None) => None,
+    };
     Ok(out)
+}
+
+/// A name or an array of names.
+fn names(value: &rhai::Dynamic, function: &str) -> ScriptResult<Vec<String>> {
+    if value.is_string() {
+        return Ok(vec![value.to_string()]);
+    }
+    let bad = || format!("{function} option names must be a string or an array of strings");
+    let list = value
+        .clone()
+        .try_cast::<Array>()
+        .ok_or_else(bad)
+        .or_else(runtime_error)?;
+    list.iter()
+        .map(|n| {
+            if n.is_string() {
+                Ok(n.to_string())
+            } else {
+                runtime_error(bad())
+            }
+        })
+        .collect()
 }
 
 type Reader = fn(&str, &str) -> crate::Result<Vec<Face>>;

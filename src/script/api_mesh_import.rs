@@ -177,7 +177,7 @@ fn checked(mesh: Mesh, limits: &super::limits::Limits) -> ScriptResult<Mesh> {
 }
 
 fn register_files(engine: &mut Engine, policy: Rc<ReadPolicy>, limits: super::limits::Limits) {
-    // mesh_from_gmsh(path): a Gmsh MSH 4.1 file (ASCII or binary), physical groups as sets.
+    // mesh_from_gmsh(path): a Gmsh MSH 4.1 or 2.2 file (ASCII or binary), physical groups as sets.
     let (p, l) = (policy.clone(), limits.clone());
     engine.register_fn("mesh_from_gmsh", move |path: &str| -> ScriptResult<Mesh> {
         let (_, bytes) = lift(p.read_bytes(path, "Gmsh mesh"))?;

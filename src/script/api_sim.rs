@@ -47,7 +47,7 @@ pub struct SimState {
     progress: Option<indicatif::ProgressBar>,
 }
 
-type NodeSnapshot = (usize, f64, Vec<Vec<[f64; 3]>>);
+pub(super) type NodeSnapshot = (usize, f64, Vec<Vec<[f64; 3]>>);
 
 /// One increment with script friction laws applied: the simulation is not borrowed while
 /// a script function runs (it may itself query the simulation).
@@ -272,6 +272,12 @@ impl Simulations {
 }
 
 impl SimState {
+    /// Per converged increment: its index, time and per tool and candidate node the
+    /// [work, mu, status code].
+    pub(super) fn node_log(&self) -> &[NodeSnapshot] {
+        &self.node_log
+    }
+
     pub(super) fn model_mut(&mut self) -> ScriptResult<&mut Model> {
         match self.model.as_mut() {
             Some(m) => Ok(m),
@@ -678,7 +684,7 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
     register_contact(engine);
     register_stepping(engine, &host);
     register_queries(engine);
-    register_contact_queries(engine);
+    super::api_contact::register(engine);
     register_checkpoints(engine);
     register_output(engine, &host);
 }
@@ -1058,97 +1064,6 @@ fn register_queries(engine: &mut Engine) {
             })
             .unwrap_or_default()
     });
-}
-
-/// `sim.contact_nodes(name)`, `sim.contact_node(name, node)` and
-/// `sim.node_history(name, node)`: a tool's candidate nodes now, one of them, and one's
-/// work, mu and status over the converged increments.
-fn register_contact_queries(engine: &mut Engine) {
-    engine.register_fn("contact_nodes", contact_nodes);
-    // The state of one mesh node against a tool (a map as in contact_nodes).
-    engine.register_fn(
-        "contact_node",
-        |ctx: rhai::NativeCallContext,
-         s: &mut ScriptSim,
-         name: &str,
-         node: i64|
-         -> ScriptResult<Map> {
-            let all: Array = ctx.call_native_fn("contact_nodes", (s.clone(), name.to_string()))?;
-            all.into_iter()
-                .filter_map(|m| m.try_cast::<Map>())
-                .find(|m| m.get("node").and_then(|v| v.as_int().ok()) == Some(node))
-                .ok_or_else(|| format!("node {node} is not a contact candidate of tool '{name}'"))
-                .or_else(runtime_error)
-        },
-    );
-    engine.register_fn("node_history", node_history);
-}
-
-/// One map per candidate node of a tool: node, position, status, gap, forces, area,
-/// pressure, work, slip, mu.
-fn contact_nodes(s: &mut ScriptSim, name: &str) -> ScriptResult<Array> {
-    let mut st = s.borrow_mut();
-    let sim = st.simulation()?;
-    let c = lift(sim.model.tool_index(name))?;
-    let contact = &sim.model.contacts[c];
-    let mut out = Array::new();
-    for (k, state) in sim.contact_states(c).iter().enumerate() {
-        let node = contact.candidates[k];
-        let x = sim.model.mesh.nodes[node] + sim.displacement(node);
-        let mut m = Map::new();
-        m.insert("node".into(), Dynamic::from(node as i64));
-        m.insert("x".into(), Dynamic::from(array3(&x)));
-        m.insert(
-            "status".into(),
-            Dynamic::from(format!("{:?}", state.status).to_lowercase()),
-        );
-        m.insert("gap".into(), Dynamic::from(state.gap));
-        m.insert("lambda_n".into(), Dynamic::from(state.lambda_n()));
-        m.insert("lambda_t".into(), Dynamic::from(state.lambda_t_norm()));
-        m.insert("area".into(), Dynamic::from(contact.areas[k]));
-        m.insert(
-            "pressure".into(),
-            Dynamic::from(-state.lambda_n() / contact.areas[k].max(f64::MIN_POSITIVE)),
-        );
-        m.insert("work".into(), Dynamic::from(state.work));
-        m.insert("slip".into(), Dynamic::from(state.slip));
-        m.insert("mu".into(), Dynamic::from(state.mu));
-        out.push(Dynamic::from(m));
-    }
-    Ok(out)
-}
-
-/// A node's history against a tool: one map per converged increment.
-fn node_history(s: &mut ScriptSim, name: &str, node: i64) -> ScriptResult<Array> {
-    let mut st = s.borrow_mut();
-    let sim = st.simulation()?;
-    let c = lift(sim.model.tool_index(name))?;
-    let Some(k) = sim.model.contacts[c]
-        .candidates
-        .iter()
-        .position(|&n| n as i64 == node)
-    else {
-        return runtime_error(format!(
-            "node {node} is not a contact candidate of tool '{name}'"
-        ));
-    };
-    Ok(st
-        .node_log
-        .iter()
-        .map(|(index, time, tools)| {
-            let [work, mu, status] = tools[c][k];
-            let mut m = Map::new();
-            m.insert("increment".into(), Dynamic::from(*index as i64));
-            m.insert("time".into(), Dynamic::from(*time));
-            m.insert("work".into(), Dynamic::from(work));
-            m.insert("mu".into(), Dynamic::from(mu));
-            m.insert(
-                "status".into(),
-                Dynamic::from(["gap", "stick", "slip"][status as usize].to_string()),
-            );
-            Dynamic::from(m)
-        })
-        .collect())
 }
 
 /// `sim.checkpoint(path)` (the committed state, now) and the script's own values across a

@@ -6,6 +6,7 @@
 
 mod api_cad;
 mod api_charts;
+pub(crate) mod api_contact;
 mod api_mesh_import;
 mod api_mesh_map;
 mod api_numbers;

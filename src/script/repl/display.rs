@@ -51,6 +51,9 @@ pub fn value(v: &Dynamic) -> String {
             .map(|(k, x)| format!("{:?}: {}", k.as_str(), value(x)))
             .collect();
         format!("#{{{}}}", items.join(", "))
+    } else if let Some(n) = v.read_lock::<crate::script::api_contact::ContactNode>() {
+        // A contact-node record shows as the map it reads like.
+        value(&Dynamic::from(n.to_map()))
     } else {
         v.to_string()
     }

@@ -1,4 +1,4 @@
-"""Writes the Gmsh fixtures of tests/data/mesh with the real Gmsh (pip install gmsh).
+"""Writes the Gmsh fixtures of tests/data/mesh with the real Gmsh (pip install gmsh==4.15.2).
 
     python3 tests/data/mesh/make_gmsh_fixtures.py
 
@@ -11,6 +11,8 @@ the origin as the point group "origin". Files (MSH 4.1):
   block_4x2x2_bin.msh    the same mesh, binary
   quarter_blank.msh      NUMISHEET'93 quarter blank [0,75]^2 x [0,0.81], 10 x 10 x 1, ASCII
   tetra_box.msh          a box in tetrahedra (unsupported: the importer must refuse it)
+  block_4x2x2_v22.msh    block_4x2x2 in MSH 2.2, ASCII
+  block_4x2x2_v22_bin.msh  the same in MSH 2.2, binary
 
 The tests need only the committed outputs, never Gmsh.
 """
@@ -20,7 +22,7 @@ import gmsh
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def box(name, size, cells, binary, hexahedra=True):
+def box(name, size, cells, binary, hexahedra=True, version=4.1):
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.model.add(name)
@@ -55,7 +57,7 @@ def box(name, size, cells, binary, hexahedra=True):
             tag = gmsh.model.addPhysicalGroup(0, [pt])
             gmsh.model.setPhysicalName(0, tag, "origin")
     gmsh.model.mesh.generate(3)
-    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.MshFileVersion", version)
     gmsh.option.setNumber("Mesh.Binary", 1 if binary else 0)
     gmsh.write(os.path.join(HERE, name + ".msh"))
     gmsh.finalize()
@@ -65,3 +67,5 @@ box("block_4x2x2", (4.0, 2.0, 1.0), (4, 2, 2), binary=False)
 box("block_4x2x2_bin", (4.0, 2.0, 1.0), (4, 2, 2), binary=True)
 box("quarter_blank", (75.0, 75.0, 0.81), (10, 10, 1), binary=False)
 box("tetra_box", (1.0, 1.0, 1.0), (1, 1, 1), binary=False, hexahedra=False)
+box("block_4x2x2_v22", (4.0, 2.0, 1.0), (4, 2, 2), binary=False, version=2.2)
+box("block_4x2x2_v22_bin", (4.0, 2.0, 1.0), (4, 2, 2), binary=True, version=2.2)
