@@ -150,7 +150,10 @@ pub struct Outcome {
 }
 
 /// Runs one mutant as `tribo run` in a folder mirroring the original's (its data files are
-/// linked and the original folder is readable), killed after `limit`.
+/// linked and the original folder is readable), killed once it has used `limit` of CPU
+/// time, or [`WALL_FACTOR`] times `limit` of wall time (a process blocked without using
+/// the CPU hangs too). CPU time, because a hang is a run that never ends, not one slowed
+/// by a loaded machine: on 2 cores shared with compilers, a run of 50 s CPU took 400 s.
 pub fn run_mutant(
     bin: &Path,
     original: &Path,
@@ -190,7 +193,8 @@ pub fn run_mutant(
         if let Some(s) = child.try_wait().unwrap() {
             break Some(s);
         }
-        if start.elapsed() > limit {
+        let cpu = cpu_time(child.id()).unwrap_or_default();
+        if cpu > limit || start.elapsed() > WALL_FACTOR * limit {
             let _ = child.kill();
             let _ = child.wait();
             break None;
@@ -211,6 +215,21 @@ pub fn run_mutant(
     };
     let _ = std::fs::remove_dir_all(work);
     Outcome { verdict, stderr }
+}
+
+/// Wall time allowed per unit of the CPU limit (see [`run_mutant`]).
+pub const WALL_FACTOR: u32 = 8;
+
+/// User plus system CPU time of a running process, from `/proc/<pid>/stat` (fields 14 and
+/// 15, in clock ticks of 1/100 s, the kernel's USER_HZ on every Linux platform this runs on).
+pub fn cpu_time(pid: u32) -> Option<Duration> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The command name (field 2) is in parentheses and may hold spaces: count after it.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<u64>().ok();
+    // `rest` starts at field 3, so fields 14 and 15 are at indices 11 and 12.
+    Some(Duration::from_millis(10 * (ticks(11)? + ticks(12)?)))
 }
 
 /// The error names the place (`file.rhai:line:`) or the value at fault (`name = value`).
