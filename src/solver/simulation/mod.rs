@@ -7,6 +7,7 @@ pub mod checkpoint;
 pub mod energy;
 pub mod kinematics_check;
 pub mod step_control;
+pub mod step_end;
 pub mod stepping;
 
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
@@ -83,6 +84,14 @@ pub struct IncrementReport {
     /// the nominal increment's parts in the report fixed stepping's `step` returns.
     #[serde(default)]
     pub discarded_iterations: usize,
+    /// Whether this increment met its step's condition (`Step::until`) and so ended the
+    /// step (module `step_end`).
+    #[serde(default)]
+    pub until_met: bool,
+    /// Set when this increment reached its step's end without the step's condition: what
+    /// was asked and what was reached. The run stops there (module `step_end`).
+    #[serde(default)]
+    pub until_missed: Option<String>,
 }
 
 /// Model plus its evolving, committed solution.
@@ -132,6 +141,12 @@ pub struct Simulation {
     /// Whether the run has explained a step limit exceeded at the minimum step (in full
     /// once per run; later increments get one short line each).
     pub(super) limit_explained: bool,
+    /// The tools' schedules as the model gave them, before steps ended early changed
+    /// them (module `step_end`).
+    pub(super) base_schedules: Vec<crate::tool::Schedule>,
+    /// Steps ended by their condition: (step, time of the increment that met it), in
+    /// order. Part of the committed state.
+    pub(super) step_ends: Vec<(usize, f64)>,
 }
 
 impl Simulation {
@@ -238,6 +253,12 @@ impl Simulation {
             cycling_explained: false,
             discarded_steps: 0,
             limit_explained: false,
+            base_schedules: model
+                .contacts
+                .iter()
+                .map(|c| c.tool.schedule.clone())
+                .collect(),
+            step_ends: Vec::new(),
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -608,6 +629,8 @@ impl Simulation {
             cutback_kinds: Vec::new(),
             last_resort: None,
             discarded_iterations: 0,
+            until_met: false,
+            until_missed: None,
         }
     }
 
@@ -625,6 +648,7 @@ impl Simulation {
             controller: self.controller,
             last_step: self.last_step.clone(),
             element_memory: self.committed_memory.clone(),
+            step_ends: self.step_ends.clone(),
         }
     }
 
@@ -643,6 +667,7 @@ impl Simulation {
         self.last_step = state.last_step;
         self.committed_memory = state.element_memory;
         self.committed_forces = None;
+        self.set_step_ends(state.step_ends);
     }
 
     /// Replaces the settings of a running simulation (after a rollback in the REPL, say).
