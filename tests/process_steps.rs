@@ -209,6 +209,21 @@ fn a_step_ending_without_its_condition_stops_the_run_naming_both() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+#[test]
+fn a_release_with_a_rigid_body_mode_left_free_is_refused_naming_it() {
+    // The block is fixed in z on its bottom face only: once released from the punch it
+    // can slide in x and y and turn about z.
+    let err = script_error(
+        "release_free",
+        r#"[#{ name: "lift", duration: 1.0, release: true, tools: #{ punch: #{ move: [0, 0, 1] } } }]"#,
+    );
+    assert!(
+        err.contains("step 0 ('lift') releases the sheet from every tool, but its supports leave 3 rigid-body mode(s) free: translation x; translation y; rotation about z"),
+        "{err}"
+    );
+    assert!(err.contains("steps.rhai:6:"), "at sim.run(): {err}");
+}
+
 /// Runs `source` as a script in a fresh folder and returns its error message.
 fn script_error(name: &str, steps: &str) -> String {
     let dir = TestDir::new(&format!("tribo-steps-{name}-{}", std::process::id()));

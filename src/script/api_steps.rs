@@ -120,9 +120,18 @@ fn read_step(
     start: f64,
 ) -> ScriptResult<(Step, Vec<ToolStep>)> {
     for key in map.keys() {
-        if !["name", "duration", "increments", "tools", "end_when"].contains(&key.as_str()) {
+        if ![
+            "name",
+            "duration",
+            "increments",
+            "tools",
+            "end_when",
+            "release",
+        ]
+        .contains(&key.as_str())
+        {
             return runtime_error(format!(
-                "step {i}: unknown key '{key}' (expected name, duration, increments, tools, end_when)"
+                "step {i}: unknown key '{key}' (expected name, duration, increments, tools, end_when, release)"
             ));
         }
     }
@@ -166,11 +175,19 @@ fn read_step(
         None => None,
         Some(v) => Some(read_until(&at, v, names)?),
     };
+    let release = match map.get("release") {
+        None => false,
+        Some(v) => match v.as_bool() {
+            Ok(b) => b,
+            Err(_) => return runtime_error(format!("{at}: release = {v} must be true or false")),
+        },
+    };
     let step = Step {
         name,
         end: start + duration,
         increments,
         until,
+        release,
     };
     Ok((step, plan))
 }

@@ -36,6 +36,10 @@ pub struct Step {
     pub increments: usize,
     /// The condition ending the step before its end time, if any.
     pub until: Option<Until>,
+    /// The step releases the sheet from every tool: its supports (the Dirichlet
+    /// conditions) must then hold it statically determinate, which `Simulation::new`
+    /// checks (`rigid_modes`).
+    pub release: bool,
 }
 
 /// A condition ending a step: on tool `tool` (index into `Model::contacts`).
@@ -193,12 +197,14 @@ mod tests {
                 end: 1.0,
                 increments: 4,
                 until: None,
+                release: false,
             },
             Step {
                 name: "drawing".into(),
                 end: 21.0,
                 increments: 40,
                 until: None,
+                release: false,
             },
         ]
     }

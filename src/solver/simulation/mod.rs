@@ -179,6 +179,7 @@ impl Simulation {
             }
         }
         force_control::check(&model)?;
+        check_releases(&model)?;
         let dofs = DofMap::new(&model);
         let groups = crate::solver::linear::condense::elimination_groups(&model, &dofs);
         let pattern = Arc::new(dofs.pattern(&model).with_groups(groups));
@@ -747,6 +748,24 @@ impl Simulation {
         }
         Ok(())
     }
+}
+
+/// A step releasing the sheet from every tool needs supports that hold it: the rigid-body
+/// modes its Dirichlet conditions leave free (`rigid_modes`) are an error naming them.
+fn check_releases(model: &Model) -> Result<()> {
+    let Some((k, step)) = model.steps.iter().enumerate().find(|(_, s)| s.release) else {
+        return Ok(());
+    };
+    let free = crate::solver::model::rigid_modes::free_rigid_body_modes(model);
+    if free.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Input(format!(
+        "step {k} ('{}') releases the sheet from every tool, but its supports leave {} rigid-body mode(s) free: {} (rotations about the nodes' centroid); fix them with sim.fix (for instance the missing components at one, two and three nodes: 3-2-1)",
+        step.name,
+        free.len(),
+        free.join("; ")
+    )))
 }
 
 /// The one warning of a run about contact-status cycling: where it happened first, whether
