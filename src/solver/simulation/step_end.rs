@@ -63,7 +63,12 @@ impl Simulation {
 
     /// Makes `ends` the steps ended early and rebuilds the tools' schedules from the
     /// model's own (`base_schedules`) and them, in order.
+    /// Nothing changes when no step has ended early before or after (runs without
+    /// conditions keep their schedules as they are).
     pub(crate) fn set_step_ends(&mut self, ends: Vec<(usize, f64)>) {
+        if ends.is_empty() && self.step_ends.is_empty() {
+            return;
+        }
         for (c, base) in self.base_schedules.iter().enumerate() {
             let mut schedule = base.clone();
             for &(k, t) in &ends {
