@@ -1,10 +1,14 @@
 //! Issue 47, steps: a process in named steps (tests/scripts/clamp_draw_steps.rhai: closing
 //! with a force-controlled holder and a stationary punch, drawing, unclamping with the
 //! holder force ramped off, release with the holder switched to displacement control and
-//! the tools retracted). A run restarted from a checkpoint inside a step, or at a step's
-//! end, equals the uninterrupted run bit for bit (history.csv and the state of the last
+//! the tools retracted; also with Chaboche kinematic hardening). A run restarted from a
+//! checkpoint inside a step, or at a step's end, equals the uninterrupted run bit for bit (history.csv and the state of the last
 //! checkpoint); summary.json says what each step did; bad steps are refused with
-//! messages naming the step and the value.
+//! messages naming the step and the value. Steps ending on a condition
+//! (tests/scripts/steps_until.rhai: drawing until a punch force, lifting until the punch
+//! loses contact) end at the first increment meeting it and restart bit for bit from a
+//! checkpoint after the condition fired; a step whose end comes without its condition
+//! stops the run naming both.
 
 mod common;
 
@@ -17,13 +21,22 @@ const SCRIPT: &str = "tests/scripts/clamp_draw_steps.rhai";
 
 /// `tribo run` of the scene with a checkpoint after every increment.
 fn run(out: &Path, restart: Option<&Path>) {
+    run_script(SCRIPT, out, restart, &[]);
+}
+
+/// `tribo run` of `script` with a checkpoint after every increment and the `--set`
+/// overrides `sets`.
+fn run_script(script: &str, out: &Path, restart: Option<&Path>, sets: &[&str]) {
     let mut cmd = Command::new(BIN);
-    cmd.args(["run", SCRIPT, "--quiet", "--set", "checkpoint_every=1"])
+    cmd.args(["run", script, "--quiet", "--set", "checkpoint_every=1"])
         .arg("--out")
         .arg(out)
         .current_dir(env!("CARGO_MANIFEST_DIR"));
     if let Some(ck) = restart {
         cmd.arg("--restart").arg(ck);
+    }
+    for set in sets {
+        cmd.args(["--set", set]);
     }
     let o = cmd.output().expect("tribo runs");
     assert!(
@@ -79,6 +92,138 @@ fn restart_inside_a_step_and_at_its_end_equals_the_whole_run() {
     let _ = std::fs::remove_dir_all(&full);
 }
 
+#[test]
+fn restart_with_back_stresses_inside_a_step_equals_the_whole_run() {
+    // The same process with Chaboche kinematic hardening: the back stresses are part of
+    // the committed state a checkpoint carries.
+    let tag = std::process::id();
+    let kinematic = ["kinematic=true"];
+    let full = TestDir::new(&format!("tribo-steps-chaboche-full-{tag}"));
+    run_script(SCRIPT, &full, None, &kinematic);
+    let summary = json(&full.join("summary.json"));
+    let last = summary["increments"].as_u64().unwrap();
+    let end = format!("checkpoints/checkpoint_{last:04}.json");
+    let state = json(&full.join(&end))["state"].clone();
+    // The test means something only if the back stresses are not zero (measured: up to
+    // some 20 MPa while drawing; points that never yielded write none).
+    let largest = state["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|p| p["back_stress"].as_array())
+        .flatten()
+        .filter_map(|term| term.as_array())
+        .flatten()
+        .filter_map(|v| v.as_f64())
+        .fold(0.0, |m: f64, v| m.max(v.abs()));
+    assert!(largest > 1.0, "back stresses of {largest} MPa");
+    // Inside the drawing step (8 of increments 5-12) and inside the unclamping step,
+    // where the holder lets go (16 of 13-21; measured step ranges).
+    for at in [8, 16] {
+        let out = TestDir::new(&format!("tribo-steps-chaboche-restart{at}-{tag}"));
+        let ck = full.join(format!("checkpoints/checkpoint_{at:04}.json"));
+        run_script(SCRIPT, &out, Some(&ck), &kinematic);
+        assert_eq!(
+            std::fs::read(full.join("history.csv")).unwrap(),
+            std::fs::read(out.join("history.csv")).unwrap(),
+            "history.csv after a restart from increment {at}"
+        );
+        assert_eq!(
+            state,
+            json(&out.join(&end))["state"],
+            "final state, back stresses included, after a restart from increment {at}"
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    let _ = std::fs::remove_dir_all(&full);
+}
+
+const UNTIL: &str = "tests/scripts/steps_until.rhai";
+
+#[test]
+fn steps_ending_on_a_condition_end_there_and_restart_bit_for_bit() {
+    let tag = std::process::id();
+    let full = TestDir::new(&format!("tribo-until-full-{tag}"));
+    // The script checks where each step ended and where the tools stood (it fails the run
+    // otherwise); here, what summary.json says and the restart.
+    run_script(UNTIL, &full, None, &[]);
+    let summary = json(&full.join("summary.json"));
+    let steps = summary["steps"].as_array().expect("summary.json has steps");
+    let met: Vec<Option<f64>> = steps
+        .iter()
+        .map(|s| s["end_when_met_at"].as_f64())
+        .collect();
+    // The drawing step (1, to t = 5) ended inside, the lifting step (3, to t = 7) too;
+    // the others have no condition (measured: 4.5 and 6.375).
+    assert!(met[0].is_none() && met[2].is_none(), "{met:?}");
+    assert!(met[1].is_some_and(|t| t > 1.0 && t < 5.0), "{met:?}");
+    assert!(met[3].is_some_and(|t| t > 6.0 && t < 7.0), "{met:?}");
+    assert_eq!(steps[1]["end_when"], "tool 'punch' force >= 26");
+    assert_eq!(steps[3]["end_when"], "tool 'punch' contact lost");
+    let last = summary["increments"].as_u64().unwrap();
+    let fired = steps[1]["last_increment"].as_u64().unwrap();
+    // Right after the drawing's condition fired (time jumped to 5), and inside the lifting.
+    for at in [fired, last - 2] {
+        let out = TestDir::new(&format!("tribo-until-restart{at}-{tag}"));
+        let ck = full.join(format!("checkpoints/checkpoint_{at:04}.json"));
+        run_script(UNTIL, &out, Some(&ck), &[]);
+        assert_eq!(
+            std::fs::read(full.join("history.csv")).unwrap(),
+            std::fs::read(out.join("history.csv")).unwrap(),
+            "history.csv after a restart from increment {at}"
+        );
+        let end = format!("checkpoints/checkpoint_{last:04}.json");
+        assert_eq!(
+            json(&full.join(&end))["state"],
+            json(&out.join(&end))["state"],
+            "final state after a restart from increment {at}"
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    let _ = std::fs::remove_dir_all(&full);
+}
+
+#[test]
+fn a_step_ending_without_its_condition_stops_the_run_naming_both() {
+    let out = TestDir::new(&format!("tribo-until-missed-{}", std::process::id()));
+    // The punch force reaches 41.9 N at the drawing's end (measured): 60 N is never met.
+    let o = Command::new(BIN)
+        .args(["run", UNTIL, "--quiet", "--set", "punch_stop=60.0"])
+        .arg("--out")
+        .arg(&*out)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("tribo runs");
+    assert!(!o.status.success(), "the run must stop");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("step 1 ('drawing') reached its end t = 5 without its condition (tool 'punch' force >= 60)"),
+        "{err}"
+    );
+    // The increment that reached the end is recorded before the run stops.
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert!(
+        history.lines().any(|l| l.starts_with("12,1,5,")),
+        "{history}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn a_release_with_a_rigid_body_mode_left_free_is_refused_naming_it() {
+    // The block is fixed in z on its bottom face only: once released from the punch it
+    // can slide in x and y and turn about z.
+    let err = script_error(
+        "release_free",
+        r#"[#{ name: "lift", duration: 1.0, release: true, tools: #{ punch: #{ move: [0, 0, 1] } } }]"#,
+    );
+    assert!(
+        err.contains("step 0 ('lift') releases the sheet from every tool, but its supports leave 3 rigid-body mode(s) free: translation x; translation y; rotation about z"),
+        "{err}"
+    );
+    assert!(err.contains("steps.rhai:6:"), "at sim.run(): {err}");
+}
+
 /// Runs `source` as a script in a fresh folder and returns its error message.
 fn script_error(name: &str, steps: &str) -> String {
     let dir = TestDir::new(&format!("tribo-steps-{name}-{}", std::process::id()));
@@ -132,6 +277,21 @@ fn bad_steps_are_refused_naming_the_step_and_the_value() {
             "unknown_key",
             r#"[#{ name: "close", duration: 1.0, tools: #{ punch: #{ mvoe: [0, 0, 1] } } }]"#,
             "step 0 ('close'), tool 'punch': unknown key 'mvoe'",
+        ),
+        (
+            "end_when_tool",
+            r#"[#{ name: "draw", duration: 1.0, end_when: #{ tool: "pnuch", force: 5.0 } }]"#,
+            "step 0 ('draw') end_when: no tool named 'pnuch' (the tools added so far: punch)",
+        ),
+        (
+            "end_when_contact",
+            r#"[#{ name: "lift", duration: 1.0, end_when: #{ tool: "punch", contact: "gone" } }]"#,
+            "step 0 ('lift') end_when: contact = gone (only \"lost\" is known)",
+        ),
+        (
+            "end_when_force",
+            r#"[#{ name: "draw", duration: 1.0, end_when: #{ tool: "punch", force: -5.0 } }]"#,
+            "step 0 ('draw') end_when: force = -5 must be > 0",
         ),
         (
             "force_fraction",

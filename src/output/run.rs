@@ -660,7 +660,7 @@ mod tests {
 
 /// summary.json's `steps`: per step of the process, its name, interval of pseudo-time and
 /// planned increments, and what the run did in it (increments, Newton iterations,
-/// cutbacks, frames, whether it was completed).
+/// cutbacks, frames, whether it was completed, its condition and when it was met).
 fn steps_summary(sim: &Simulation, frame_times: &[f64]) -> serde_json::Value {
     use crate::solver::model::steps;
     let list = &sim.model.steps;
@@ -682,6 +682,8 @@ fn steps_summary(sim: &Simulation, frame_times: &[f64]) -> serde_json::Value {
             "cutbacks": done.iter().map(|r| r.cutbacks).sum::<usize>(),
             "frames": frames,
             "completed": sim.time() >= s.end * (1.0 - 1e-12),
+            "end_when": s.until.as_ref().map(|u| u.describe(&sim.model.contacts[u.tool].tool.name)),
+            "end_when_met_at": sim.step_ends().iter().find(|e| e.0 == k).map(|e| e.1),
         })
     });
     serde_json::Value::Array(entries.collect())

@@ -105,6 +105,11 @@ fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementRepo
         }
     }
     s.borrow_mut().record_step(&report)?;
+    if let Some(missed) = &report.until_missed {
+        // Recorded (history row, frame), then the run stops: the next step would start
+        // from a state its process did not reach.
+        return runtime_error(missed.clone());
+    }
     Ok(report)
 }
 
@@ -513,7 +518,8 @@ impl SimState {
                 lift(out.write_frame_if_due(sim, report.index))?;
                 // A process in steps: a frame at every step's end (the formed, the
                 // clamped and the released shapes).
-                let at_step_end = (sim.model.steps.iter()).any(|s| s.end == report.time);
+                let at_step_end =
+                    report.until_met || (sim.model.steps.iter()).any(|s| s.end == report.time);
                 if at_step_end && out.frame_times().last() != Some(&report.time) {
                     lift(out.write_frame(sim))?;
                 }

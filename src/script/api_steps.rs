@@ -14,6 +14,11 @@
 //! (tool not named)              held where it is
 //! ```
 //!
+//! A step's `end_when: #{ tool: name, force: F }` or `end_when: #{ tool: name, contact: "lost" }`
+//! ends it at the first increment where the tool's contact force magnitude reaches `F`
+//! or no node touches the tool; the rest of its pseudo-time is skipped and the tools hold
+//! where they were (solver `simulation::step_end`).
+//!
 //! Compiled: a tool's translation becomes the piecewise-linear schedule through its
 //! translation at every step end (`u_k = u_{k-1} + move_k`), and a tool force-controlled in
 //! some step gets one `ForceControl` whose `windows` are those steps and whose force
@@ -27,7 +32,7 @@ use super::api_scene::scalar_schedule;
 use super::api_sim::ScriptSim;
 use super::convert::*;
 use crate::geometry::Vec3;
-use crate::solver::model::steps::Step;
+use crate::solver::model::steps::{Condition, Step, Until};
 use crate::solver::model::Model;
 use crate::tool::{ForceControl, ScalarSchedule, Schedule};
 use rhai::{Array, Dynamic, Engine, Map};
@@ -115,9 +120,18 @@ fn read_step(
     start: f64,
 ) -> ScriptResult<(Step, Vec<ToolStep>)> {
     for key in map.keys() {
-        if !["name", "duration", "increments", "tools"].contains(&key.as_str()) {
+        if ![
+            "name",
+            "duration",
+            "increments",
+            "tools",
+            "end_when",
+            "release",
+        ]
+        .contains(&key.as_str())
+        {
             return runtime_error(format!(
-                "step {i}: unknown key '{key}' (expected name, duration, increments, tools)"
+                "step {i}: unknown key '{key}' (expected name, duration, increments, tools, end_when, release)"
             ));
         }
     }
@@ -157,12 +171,73 @@ fn read_step(
             plan[c] = read_tool_step(&format!("{at}, tool '{tool}'"), spec)?;
         }
     }
+    let until = match map.get("end_when") {
+        None => None,
+        Some(v) => Some(read_until(&at, v, names)?),
+    };
+    let release = match map.get("release") {
+        None => false,
+        Some(v) => match v.as_bool() {
+            Ok(b) => b,
+            Err(_) => return runtime_error(format!("{at}: release = {v} must be true or false")),
+        },
+    };
     let step = Step {
         name,
         end: start + duration,
         increments,
+        until,
+        release,
     };
     Ok((step, plan))
+}
+
+/// A step's condition: `#{ tool: name, force: F }` (F > 0) or `#{ tool: name, contact:
+/// "lost" }`.
+fn read_until(at: &str, v: &Dynamic, names: &[String]) -> ScriptResult<Until> {
+    let expected = "expected #{ tool: name, force: F } or #{ tool: name, contact: \"lost\" }";
+    let Some(map) = v.clone().try_cast::<Map>() else {
+        return runtime_error(format!("{at} end_when: {expected}"));
+    };
+    if let Some(key) = map
+        .keys()
+        .find(|k| !["tool", "force", "contact"].contains(&k.as_str()))
+    {
+        return runtime_error(format!("{at} end_when: unknown key '{key}' ({expected})"));
+    }
+    let tool = match map.get("tool").and_then(|t| t.clone().into_string().ok()) {
+        Some(t) => t,
+        None => return runtime_error(format!("{at} end_when: `tool` (a string) is missing")),
+    };
+    let Some(c) = names.iter().position(|n| *n == tool) else {
+        return runtime_error(format!(
+            "{at} end_when: no tool named '{tool}' (the tools added so far: {})",
+            names.join(", ")
+        ));
+    };
+    let condition = match (map.get("force"), map.get("contact")) {
+        (Some(f), None) => {
+            let f = number(f, &format!("{at} end_when force"))?;
+            if !(f.is_finite() && f > 0.0) {
+                return runtime_error(format!("{at} end_when: force = {f} must be > 0"));
+            }
+            Condition::Force(f)
+        }
+        (None, Some(c)) if c.clone().into_string().ok().as_deref() == Some("lost") => {
+            Condition::ContactLost
+        }
+        (None, Some(c)) => {
+            return runtime_error(format!(
+                "{at} end_when: contact = {c} (only \"lost\" is known)"
+            ))
+        }
+        _ => {
+            return runtime_error(format!(
+                "{at} end_when: give one of force or contact ({expected})"
+            ))
+        }
+    };
+    Ok(Until { tool: c, condition })
 }
 
 /// A tool's map in a step: `move`, `force`, `axis`.

@@ -106,6 +106,31 @@ impl Schedule {
     pub fn points(&self) -> &[(f64, Vec3)] {
         &self.points
     }
+
+    /// The schedule of a tool that stops at `from` and holds there until `to` (a step
+    /// ended early at `from`, its rest skipped): `u(from)` on `[from, to]`, and after `to`
+    /// the old motion shifted by `u(from) - u(to)`, so that it goes on from where the tool
+    /// stopped. Unchanged for `from >= to`; the rotation is kept as it is.
+    pub fn held_between(&self, from: f64, to: f64) -> Schedule {
+        if from >= to {
+            return self.clone();
+        }
+        let held = self.translation(from);
+        let shift = held - self.translation(to);
+        let mut points: Vec<(f64, Vec3)> =
+            self.points.iter().copied().filter(|p| p.0 < from).collect();
+        points.push((from, held));
+        points.push((to, held));
+        points.extend(
+            (self.points.iter())
+                .filter(|p| p.0 > to)
+                .map(|&(t, u)| (t, u + shift)),
+        );
+        Schedule {
+            points,
+            rotation: self.rotation.clone(),
+        }
+    }
 }
 
 /// Scalar piecewise-linear function of pseudo-time (prescribed displacement values,
@@ -219,6 +244,23 @@ fn end_time<T>(points: &[(f64, T)]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_held_schedule_stops_and_goes_on_from_where_it_stopped() {
+        let s = Schedule::new(vec![
+            (0.0, Vec3::zeros()),
+            (2.0, Vec3::new(0.0, 0.0, -4.0)),
+            (3.0, Vec3::new(0.0, 0.0, -3.0)),
+        ])
+        .unwrap();
+        let h = s.held_between(1.0, 2.0);
+        assert_eq!(h.translation(0.5), s.translation(0.5), "unchanged before");
+        assert_eq!(h.translation(1.5), Vec3::new(0.0, 0.0, -2.0), "held");
+        assert_eq!(h.translation(2.0), Vec3::new(0.0, 0.0, -2.0));
+        // The next step's move (+1 over [2, 3]) from where the tool stopped.
+        assert_eq!(h.translation(3.0), Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(s.held_between(2.0, 2.0), s);
+    }
 
     fn v(x: f64, y: f64, z: f64) -> Vec3 {
         Vec3::new(x, y, z)

@@ -3,6 +3,7 @@
 
 pub mod augmentation;
 pub mod follower_load;
+pub mod rigid_modes;
 pub mod steps;
 
 use crate::geometry::Vec3;

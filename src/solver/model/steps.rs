@@ -9,6 +9,17 @@
 //! So the committed state at a time says everything, and a checkpoint taken anywhere,
 //! inside a step or at its end, restarts the same run.
 //!
+//! A step may end on a condition (`Step::until`): a tool's contact force reaching a value,
+//! or the tool losing contact (no active candidate node). The step then ends at the first
+//! increment meeting it, at `t_f <= t_k`; the rest of its pseudo-time `(t_f, t_k]` is
+//! skipped: the committed time jumps to `t_k` and every tool holds there where it was at
+//! `t_f` (its translation `u(t)` becomes `u(t_f)` on `[t_f, t_k]` and `u(t) + u(t_f) - u(t_k)`
+//! after, `Schedule::held_between`), so the next step starts from the state reached and
+//! its moves are relative to it. Which steps ended early, and when, is part of the
+//! committed state (`Simulation::step_ends`, kept in checkpoints), so that a restart
+//! rebuilds the same schedules. A step whose end is reached without its condition stops
+//! the run (the increment report says so, `IncrementReport::until_missed`).
+//!
 //! Fixed stepping takes `(t_k - t_{k-1}) / n_k` in step `k` and never crosses a step end;
 //! adaptive stepping lands on every step end (`step_control::schedule_stops`). An increment
 //! ending at time `t` belongs to the step whose interval holds `t`.
@@ -23,6 +34,51 @@ pub struct Step {
     pub end: f64,
     /// Nominal increments of fixed stepping in the step (>= 1).
     pub increments: usize,
+    /// The condition ending the step before its end time, if any.
+    pub until: Option<Until>,
+    /// The step releases the sheet from every tool: its supports (the Dirichlet
+    /// conditions) must then hold it statically determinate, which `Simulation::new`
+    /// checks (`rigid_modes`).
+    pub release: bool,
+}
+
+/// A condition ending a step: on tool `tool` (index into `Model::contacts`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Until {
+    pub tool: usize,
+    pub condition: Condition,
+}
+
+/// What ends a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Condition {
+    /// The magnitude of the tool's total contact force `|sum lambda|` reaches this value
+    /// (force units, > 0).
+    Force(f64),
+    /// No candidate node of the tool is in contact (status gap everywhere).
+    ContactLost,
+}
+
+impl Until {
+    /// Whether the condition holds for a tool with total contact force `force` and
+    /// `active` nodes in contact.
+    pub fn met(&self, force: [f64; 3], active: usize) -> bool {
+        match self.condition {
+            Condition::Force(f) => {
+                (force[0] * force[0] + force[1] * force[1] + force[2] * force[2]).sqrt() >= f
+            }
+            Condition::ContactLost => active == 0,
+        }
+    }
+
+    /// The condition in words, for messages: `tool 'punch' force >= 500` or `tool
+    /// 'punch' contact lost`.
+    pub fn describe(&self, tool_name: &str) -> String {
+        match self.condition {
+            Condition::Force(f) => format!("tool '{tool_name}' force >= {f}"),
+            Condition::ContactLost => format!("tool '{tool_name}' contact lost"),
+        }
+    }
 }
 
 /// Relative tolerance on times: an increment ending this close to a step end ends there.
@@ -57,6 +113,19 @@ pub fn validate(steps: &[Step]) -> Result<()> {
         }
         if s.increments == 0 {
             return Err(Error::input(&what("increments"), 0, "must be >= 1"));
+        }
+        if let Some(Until {
+            condition: Condition::Force(f),
+            ..
+        }) = s.until
+        {
+            if !(f.is_finite() && f > 0.0) {
+                return Err(Error::input(
+                    &what("until force"),
+                    f,
+                    "must be finite and > 0",
+                ));
+            }
         }
         previous = s.end;
     }
@@ -127,11 +196,15 @@ mod tests {
                 name: "closing".into(),
                 end: 1.0,
                 increments: 4,
+                until: None,
+                release: false,
             },
             Step {
                 name: "drawing".into(),
                 end: 21.0,
                 increments: 40,
+                until: None,
+                release: false,
             },
         ]
     }
@@ -167,6 +240,29 @@ mod tests {
         s[0].increments = 0;
         let e = validate(&s).unwrap_err().to_string();
         assert!(e.contains("step 0 ('closing') increments"), "{e}");
+        let mut s = steps();
+        s[1].until = Some(Until {
+            tool: 0,
+            condition: Condition::Force(-1.0),
+        });
+        let e = validate(&s).unwrap_err().to_string();
+        assert!(e.contains("step 1 ('drawing') until force = -1"), "{e}");
         assert!(validate(&steps()).is_ok());
+    }
+
+    #[test]
+    fn conditions_hold_at_their_threshold() {
+        let force = Until {
+            tool: 0,
+            condition: Condition::Force(5.0),
+        };
+        assert!(force.met([3.0, 0.0, 4.0], 2), "|F| = 5 reaches 5");
+        assert!(!force.met([3.0, 0.0, 3.9], 2));
+        let lost = Until {
+            tool: 0,
+            condition: Condition::ContactLost,
+        };
+        assert!(lost.met([0.0; 3], 0) && !lost.met([0.0; 3], 1));
+        assert_eq!(force.describe("punch"), "tool 'punch' force >= 5");
     }
 }

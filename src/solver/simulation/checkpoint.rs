@@ -51,6 +51,11 @@ pub struct SavedState {
     /// increment's first local solves start cold).
     #[serde(default, with = "nan_as_null")]
     pub element_memory: Vec<f64>,
+    /// Steps ended early by their condition: (step index, time of the increment that met
+    /// it); the tools' schedules are rebuilt from them (module `step_end`). Absent from
+    /// older checkpoints (none).
+    #[serde(default)]
+    pub step_ends: Vec<(usize, f64)>,
 }
 
 /// A vector of numbers, NaN among them, as JSON (which has no NaN): NaN as `null`.
@@ -255,6 +260,9 @@ impl Checkpoint {
                 "the checkpoint is inconsistent (array sizes do not match its model)".into(),
             ));
         }
+        // The schedules of steps ended early, before the tools' poses are compared.
+        sim.check_step_ends(&s.step_ends)?;
+        sim.set_step_ends(s.step_ends.clone());
         for (c, (contact, stored)) in sim.model.contacts.iter().zip(&self.tool_poses).enumerate() {
             let here = pose_points(&contact.tool.pose(s.time));
             let d = here

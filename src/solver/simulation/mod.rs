@@ -7,6 +7,7 @@ pub mod checkpoint;
 pub mod energy;
 pub mod kinematics_check;
 pub mod step_control;
+pub mod step_end;
 pub mod stepping;
 
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
@@ -83,6 +84,14 @@ pub struct IncrementReport {
     /// the nominal increment's parts in the report fixed stepping's `step` returns.
     #[serde(default)]
     pub discarded_iterations: usize,
+    /// Whether this increment met its step's condition (`Step::until`) and so ended the
+    /// step (module `step_end`).
+    #[serde(default)]
+    pub until_met: bool,
+    /// Set when this increment reached its step's end without the step's condition: what
+    /// was asked and what was reached. The run stops there (module `step_end`).
+    #[serde(default)]
+    pub until_missed: Option<String>,
 }
 
 /// Model plus its evolving, committed solution.
@@ -132,6 +141,12 @@ pub struct Simulation {
     /// Whether the run has explained a step limit exceeded at the minimum step (in full
     /// once per run; later increments get one short line each).
     pub(super) limit_explained: bool,
+    /// The tools' schedules as the model gave them, before steps ended early changed
+    /// them (module `step_end`).
+    pub(super) base_schedules: Vec<crate::tool::Schedule>,
+    /// Steps ended by their condition: (step, time of the increment that met it), in
+    /// order. Part of the committed state.
+    pub(super) step_ends: Vec<(usize, f64)>,
 }
 
 impl Simulation {
@@ -164,6 +179,7 @@ impl Simulation {
             }
         }
         force_control::check(&model)?;
+        check_releases(&model)?;
         let dofs = DofMap::new(&model);
         let groups = crate::solver::linear::condense::elimination_groups(&model, &dofs);
         let pattern = Arc::new(dofs.pattern(&model).with_groups(groups));
@@ -238,6 +254,12 @@ impl Simulation {
             cycling_explained: false,
             discarded_steps: 0,
             limit_explained: false,
+            base_schedules: model
+                .contacts
+                .iter()
+                .map(|c| c.tool.schedule.clone())
+                .collect(),
+            step_ends: Vec::new(),
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -608,6 +630,8 @@ impl Simulation {
             cutback_kinds: Vec::new(),
             last_resort: None,
             discarded_iterations: 0,
+            until_met: false,
+            until_missed: None,
         }
     }
 
@@ -625,6 +649,7 @@ impl Simulation {
             controller: self.controller,
             last_step: self.last_step.clone(),
             element_memory: self.committed_memory.clone(),
+            step_ends: self.step_ends.clone(),
         }
     }
 
@@ -643,6 +668,7 @@ impl Simulation {
         self.last_step = state.last_step;
         self.committed_memory = state.element_memory;
         self.committed_forces = None;
+        self.set_step_ends(state.step_ends);
     }
 
     /// Replaces the settings of a running simulation (after a rollback in the REPL, say).
@@ -722,6 +748,24 @@ impl Simulation {
         }
         Ok(())
     }
+}
+
+/// A step releasing the sheet from every tool needs supports that hold it: the rigid-body
+/// modes its Dirichlet conditions leave free (`rigid_modes`) are an error naming them.
+fn check_releases(model: &Model) -> Result<()> {
+    let Some((k, step)) = model.steps.iter().enumerate().find(|(_, s)| s.release) else {
+        return Ok(());
+    };
+    let free = crate::solver::model::rigid_modes::free_rigid_body_modes(model);
+    if free.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Input(format!(
+        "step {k} ('{}') releases the sheet from every tool, but its supports leave {} rigid-body mode(s) free: {} (rotations about the nodes' centroid); fix them with sim.fix (for instance the missing components at one, two and three nodes: 3-2-1)",
+        step.name,
+        free.len(),
+        free.join("; ")
+    )))
 }
 
 /// The one warning of a run about contact-status cycling: where it happened first, whether

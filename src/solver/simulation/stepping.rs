@@ -140,6 +140,9 @@ impl Simulation {
     /// stepping: one increment of the size the controller chose (see `step_control`).
     pub fn step(&mut self) -> Result<IncrementReport> {
         self.check_interrupt()?;
+        if let Some(missed) = self.missed_condition() {
+            return Err(Error::Input(missed));
+        }
         if self.is_finished() {
             return Err(Error::Input(format!(
                 "the simulation already reached its end time {}",
@@ -195,6 +198,7 @@ impl Simulation {
             match self.try_increment(t_new, attempt) {
                 Ok(trial) => {
                     let mut report = self.accept(t_new, trial);
+                    self.end_step_on_condition(&mut report);
                     note_last_resort(&mut report, attempt, &failures);
                     attempt = Attempt::Regular;
                     failures.clear();
@@ -203,7 +207,7 @@ impl Simulation {
                     recorded = cutbacks.count();
                     discarded += report.discarded_iterations;
                     self.history.push(report.clone());
-                    if t_new < target {
+                    if t_new < target && !report.until_met {
                         // The next part keeps this one's size; the rest is tried whole only
                         // where such a part fails (below).
                         in_a_row = 0;
@@ -301,6 +305,7 @@ impl Simulation {
                         continue;
                     }
                     let mut report = self.accept(t_new, trial);
+                    self.end_step_on_condition(&mut report);
                     note_last_resort(&mut report, attempt, &failures);
                     cutbacks.report_since(0, &mut report);
                     report.rejected = rejected;
