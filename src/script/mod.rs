@@ -69,6 +69,46 @@ pub struct HostOptions {
     pub limits: limits::Limits,
     /// The script's own time (the engine sets a fresh one).
     pub clock: Rc<limits::ScriptClock>,
+    /// What [`run_file`] does with an earlier run's files in the output folder.
+    pub earlier_outputs: EarlierOutputs,
+}
+
+/// What a run does with the files an earlier run left in its output folder (the engine's
+/// own files only: `crate::output::previous_outputs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EarlierOutputs {
+    /// Leave them (a restart continues the run in its folder; library callers that manage
+    /// their folders themselves).
+    #[default]
+    Keep,
+    /// Refuse the run, naming the folder, the files and `--overwrite` (`tribo run`).
+    Refuse,
+    /// Remove them before the run starts (`tribo run --overwrite`, the REPL's own folder).
+    Overwrite,
+}
+
+/// Applies `policy` to the earlier run's files in `dir` (to be called with the folder's
+/// lock held, so that no run is writing them).
+pub fn prepare_output_folder(dir: &Path, policy: EarlierOutputs) -> Result<()> {
+    if policy == EarlierOutputs::Keep {
+        return Ok(());
+    }
+    let files = crate::output::previous_outputs(dir)?;
+    if files.is_empty() {
+        return Ok(());
+    }
+    if policy == EarlierOutputs::Overwrite {
+        crate::output::clear_previous_outputs(dir)?;
+        return Ok(());
+    }
+    Err(Error::Input(format!(
+        "the output folder {} holds an earlier run's results ({})\n  \
+         add --overwrite to remove them first (only the files a run writes: history.csv, \
+         summary.json, *.pvd, charts, frames/*.vtu, checkpoints/*.json),\n  \
+         or choose another --out, or continue that run with --restart CHECKPOINT",
+        dir.display(),
+        crate::output::describe_outputs(dir, &files)
+    )))
 }
 
 impl Default for HostOptions {
@@ -90,6 +130,7 @@ impl Default for HostOptions {
             max_read_bytes: crate::paths::DEFAULT_MAX_READ_BYTES,
             limits: limits::Limits::default(),
             clock: Rc::default(),
+            earlier_outputs: EarlierOutputs::Keep,
         }
     }
 }
@@ -279,6 +320,7 @@ pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions
     read_policy(host, path.parent())?;
     // Held to the end of the run: a second run into the same folder is refused.
     let _lock = crate::output::FolderLock::acquire(&host.out_dir)?;
+    prepare_output_folder(&host.out_dir, host.earlier_outputs)?;
     let ast = apply_overrides(&engine, ast, overrides, path)?;
     let mut scope = Scope::new();
     let outcome = engine
