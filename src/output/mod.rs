@@ -21,6 +21,7 @@ pub mod formability;
 mod line_chart;
 mod previous_run;
 mod pvd;
+mod run_settings;
 mod shell_layers;
 mod summary;
 pub mod svg;
