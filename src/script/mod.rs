@@ -71,6 +71,10 @@ pub struct HostOptions {
     pub clock: Rc<limits::ScriptClock>,
     /// What [`run_file`] does with an earlier run's files in the output folder.
     pub earlier_outputs: EarlierOutputs,
+    /// Names of node sets `mesh.select` made after a simulation existed: a simulation holds
+    /// the copy of the mesh it was created with, so such a set never reaches it; an error
+    /// that names one as unknown says so ([`explain_late_sets`]).
+    pub late_sets: Rc<std::cell::RefCell<std::collections::BTreeSet<String>>>,
 }
 
 /// What a run does with the files an earlier run left in its output folder (the engine's
@@ -131,6 +135,7 @@ impl Default for HostOptions {
             limits: limits::Limits::default(),
             clock: Rc::default(),
             earlier_outputs: EarlierOutputs::Keep,
+            late_sets: Rc::default(),
         }
     }
 }
@@ -213,6 +218,24 @@ fn register_checks(engine: &mut Engine) {
             }
         },
     );
+}
+
+/// `message`, and when it names as unknown a node set that `mesh.select` made after a
+/// simulation was created, why, on a line of its own: a simulation holds the copy of the
+/// mesh it was created with.
+pub fn explain_late_sets(host: &HostOptions, message: String) -> String {
+    let late = host.late_sets.borrow();
+    let named = late
+        .iter()
+        .find(|name| message.contains(&format!("node set = \"{name}\" is unknown")));
+    match named {
+        Some(name) => format!(
+            "{message}\n  mesh.select(\"{name}\", ...) ran after simulation(mesh, ...): a \
+             simulation takes its own copy of the mesh when it is created, so a set selected \
+             later never reaches it; select every set before simulation(...)"
+        ),
+        None => message,
+    }
 }
 
 /// Formats a Rhai error as "file:line:column: message". An error inside a function of
@@ -314,6 +337,7 @@ pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
 /// checkpoint that no simulation used is an error.
 pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions) -> Result<()> {
     host.simulations.clear();
+    host.late_sets.borrow_mut().clear();
     let engine = engine(host, path.parent());
     let ast = compile(&engine, path)?;
     // The --allow-read folders exist (the engine would otherwise refuse every read quietly).
@@ -325,7 +349,10 @@ pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions
     let mut scope = Scope::new();
     let outcome = engine
         .run_ast_with_scope(&mut scope, &ast)
-        .map_err(|e| Error::Script(describe_error(&path.display().to_string(), &e)))
+        .map_err(|e| {
+            let text = describe_error(&path.display().to_string(), &e);
+            Error::Script(explain_late_sets(host, text))
+        })
         .and_then(|()| host.simulations.close());
     let outcome = outcome.and_then(|()| match &host.restart {
         Some(file) if !host.restart_used.get() => Err(Error::Input(format!(
