@@ -265,6 +265,34 @@ fn default_run_out(script: &PathBuf, sets: &[String]) -> PathBuf {
     PathBuf::from(name)
 }
 
+/// A long one-line message as a person reads it: its first clause (the reason) on the first
+/// line, each further clause after a "; " outside brackets on a line of its own, indented.
+/// Messages that already have lines of their own, or are short, are left as they are.
+fn readable(message: &str) -> String {
+    if message.contains('\n') || message.len() <= 160 {
+        return message.to_string();
+    }
+    let mut out = String::new();
+    let mut depth = 0i32;
+    let mut rest = message.char_indices().peekable();
+    let mut start = 0;
+    while let Some((i, c)) = rest.next() {
+        depth += match c {
+            '(' | '[' | '{' => 1,
+            ')' | ']' | '}' => -1,
+            _ => 0,
+        };
+        if c == ';' && depth == 0 && rest.peek().is_some_and(|&(_, n)| n == ' ') {
+            out.push_str(&message[start..i]);
+            out.push_str("\n  ");
+            rest.next();
+            start = i + 2;
+        }
+    }
+    out.push_str(&message[start..]);
+    out
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -367,7 +395,7 @@ fn main() -> ExitCode {
             ExitCode::from(tribo::interrupt::EXIT_INTERRUPTED)
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", readable(&e.to_string()));
             ExitCode::FAILURE
         }
     }
