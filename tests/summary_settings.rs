@@ -84,6 +84,28 @@ fn summaries_differ_in_exactly_the_setting_that_differs() {
         assert!(settings.contains_key(key), "settings.{key} missing");
     }
 
+    // Every key of sim.settings that configures the solver (the others are the output's and
+    // the checkpoints', in summary.json's other entries).
+    let output_keys = [
+        "output_every",
+        "output_interval",
+        "frame_points",
+        "units",
+        "model_fraction",
+        "flc",
+        "flc_safety_margin",
+        "thinning_limit",
+        "stretch_limit",
+        "wrinkle_limit",
+        "checkpoint_every",
+    ];
+    for key in tribo::script::SETTING_KEYS {
+        assert!(
+            settings.contains_key(*key) || output_keys.contains(key),
+            "setting {key} missing from summary.json's settings"
+        );
+    }
+
     let mut diff = Vec::new();
     differences(&defaults, &explicit_default, "", &mut diff);
     assert!(
