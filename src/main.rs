@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use tribo::script::{self, HostOptions};
+use tribo::script::{self, EarlierOutputs, HostOptions};
 
 #[derive(Parser)]
 #[command(
@@ -22,7 +22,8 @@ enum Command {
     Run {
         /// The .rhai process script.
         script: PathBuf,
-        /// Output folder (default: out/<script name>).
+        /// Output folder (default: out/<script name>, with _NAME-VALUE for each --set:
+        /// out/square_cup_variant-benchmark).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Override a top-level `let NAME = ...;` of the script: --set cells=50 --set variant="benchmark".
@@ -33,8 +34,14 @@ enum Command {
         quiet: bool,
         /// Continue from a checkpoint (written with settings checkpoint_every, sim.checkpoint,
         /// or at a stop): the script builds the model again, then the state is loaded.
+        /// The output folder's files are kept (the run continues there).
         #[arg(long, value_name = "CHECKPOINT")]
         restart: Option<PathBuf>,
+        /// Remove an earlier run's results from the output folder before running (only the
+        /// files a run writes: history.csv, summary.json, *.pvd, charts with their CSV,
+        /// frames/*.vtu, checkpoints/*.json). Without it a folder holding them is refused.
+        #[arg(long, conflicts_with = "restart")]
+        overwrite: bool,
         #[command(flatten)]
         limits: Limits,
     },
@@ -95,7 +102,9 @@ enum Command {
     Repl {
         /// A process script whose scene to load before the prompt.
         script: Option<PathBuf>,
-        /// Output folder of the simulations (default: out/<script name>, or out/repl).
+        /// The REPL writes into OUT/repl (default OUT: out/<script name>, or out), its own
+        /// folder, so that it never mixes with a run's results in OUT; each session starts
+        /// by removing the previous session's results there.
         #[arg(long)]
         out: Option<PathBuf>,
         #[command(flatten)]
@@ -234,6 +243,56 @@ fn default_out(script: Option<&PathBuf>) -> PathBuf {
     PathBuf::from("out").join(stem)
 }
 
+/// The default folder of `tribo run`: out/<script name>, and for each `--set` in the order
+/// given `_NAME-VALUE` (quotes dropped, characters other than letters, digits, `.`, `+` and
+/// `-` as `_`), so that the variants of one script each have their own folder:
+/// out/square_cup, out/square_cup_variant-benchmark, out/square_cup_cells-50_layers-2.
+fn default_run_out(script: &PathBuf, sets: &[String]) -> PathBuf {
+    let mut name = default_out(Some(script)).into_os_string();
+    for set in sets {
+        let (key, value) = set.split_once('=').unwrap_or((set, ""));
+        let value = value.trim().trim_matches(|c| c == '"' || c == '\'');
+        let safe = |t: &str| -> String {
+            t.chars()
+                .map(|c| match c {
+                    c if c.is_ascii_alphanumeric() || ".+-".contains(c) => c,
+                    _ => '_',
+                })
+                .collect()
+        };
+        name.push(format!("_{}-{}", safe(key.trim()), safe(value)));
+    }
+    PathBuf::from(name)
+}
+
+/// A long one-line message as a person reads it: its first clause (the reason) on the first
+/// line, each further clause after a "; " outside brackets on a line of its own, indented.
+/// Messages that already have lines of their own, or are short, are left as they are.
+fn readable(message: &str) -> String {
+    if message.contains('\n') || message.len() <= 160 {
+        return message.to_string();
+    }
+    let mut out = String::new();
+    let mut depth = 0i32;
+    let mut rest = message.char_indices().peekable();
+    let mut start = 0;
+    while let Some((i, c)) = rest.next() {
+        depth += match c {
+            '(' | '[' | '{' => 1,
+            ')' | ']' | '}' => -1,
+            _ => 0,
+        };
+        if c == ';' && depth == 0 && rest.peek().is_some_and(|&(_, n)| n == ' ') {
+            out.push_str(&message[start..i]);
+            out.push_str("\n  ");
+            rest.next();
+            start = i + 2;
+        }
+    }
+    out.push_str(&message[start..]);
+    out
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -243,6 +302,7 @@ fn main() -> ExitCode {
             set,
             quiet,
             restart,
+            overwrite,
             limits,
         } => (|| {
             let overrides = set
@@ -250,8 +310,13 @@ fn main() -> ExitCode {
                 .map(|s| script::parse_override(s))
                 .collect::<tribo::Result<Vec<_>>>()?;
             let mut host = HostOptions {
-                out_dir: out.unwrap_or_else(|| default_out(Some(&script))),
+                out_dir: out.unwrap_or_else(|| default_run_out(&script, &set)),
                 progress: !quiet,
+                earlier_outputs: match (&restart, overwrite) {
+                    (Some(_), _) => EarlierOutputs::Keep,
+                    (None, true) => EarlierOutputs::Overwrite,
+                    (None, false) => EarlierOutputs::Refuse,
+                },
                 restart,
                 ..HostOptions::default()
             };
@@ -300,8 +365,12 @@ fn main() -> ExitCode {
             out,
             limits,
         } => {
+            let out = out.unwrap_or_else(|| match &script {
+                Some(_) => default_out(script.as_ref()),
+                None => PathBuf::from("out"),
+            });
             let mut host = HostOptions {
-                out_dir: out.unwrap_or_else(|| default_out(script.as_ref())),
+                out_dir: out.join("repl"),
                 progress: true,
                 ..HostOptions::default()
             };
@@ -309,7 +378,12 @@ fn main() -> ExitCode {
             host.interrupt
                 .install_signal_handlers()
                 .and_then(|()| tribo::output::FolderLock::acquire(&host.out_dir))
-                .and_then(|_lock| script::repl::run(script.as_deref(), &host))
+                .and_then(|lock| {
+                    script::prepare_output_folder(&host.out_dir, EarlierOutputs::Overwrite)?;
+                    script::repl::run(script.as_deref(), &host)?;
+                    drop(lock);
+                    Ok(())
+                })
         }
     };
     match result {
@@ -321,7 +395,7 @@ fn main() -> ExitCode {
             ExitCode::from(tribo::interrupt::EXIT_INTERRUPTED)
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", readable(&e.to_string()));
             ExitCode::FAILURE
         }
     }

@@ -151,15 +151,17 @@ fn command_lines_run_as_written() {
     let dir = temp_dir("commands");
     let mut ran = 0;
     let mut sweep_out: Option<PathBuf> = None;
-    for (section, body) in blocks("sh") {
+    for (b, (section, body)) in blocks("sh").into_iter().enumerate() {
         if section == "Commands" {
             continue; // usage lines, checked by `usage_lines_name_options_the_cli_has`
         }
         for (k, line) in body.lines().enumerate() {
+            // A folder per line (block b, line k): a used folder is refused (issue 52), as the
+            // README says; two blocks of one section used to share their folders.
             let out = if line.contains("sweep collect") {
                 sweep_out.clone().expect("a sweep before its collect")
             } else {
-                dir.join(format!("{}_{k}", section.replace(' ', "_")))
+                dir.join(format!("{}_{b}_{k}", section.replace(' ', "_")))
             };
             let Ok(args) = runnable(line, &out) else {
                 continue;

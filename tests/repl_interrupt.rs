@@ -22,8 +22,9 @@ fn scene() -> String {
     )
 }
 
+/// Rows of the REPL's history.csv (in its own folder below --out, issue 52).
 fn history_rows(out: &Path) -> usize {
-    std::fs::read_to_string(out.join("history.csv"))
+    std::fs::read_to_string(out.join("repl/history.csv"))
         .map(|t| t.lines().count().saturating_sub(1))
         .unwrap_or(0)
 }

@@ -449,7 +449,8 @@ fn repl_rolls_back_and_changes_a_setting_before_stepping_on() {
         stdout.contains("cannot roll back 9 increment(s)"),
         "{stdout}"
     );
-    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    // The REPL writes into its own folder below --out (issue 52).
+    let history = std::fs::read_to_string(out.join("repl/history.csv")).unwrap();
     assert_eq!(
         history.lines().count(),
         1 + 3,

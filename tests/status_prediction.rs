@@ -190,6 +190,14 @@ fn the_cycling_warning_suggests_prediction_only_where_it_is_off() {
         let stdout = String::from_utf8_lossy(&output.stdout);
         let text = format!("{stdout}{stderr}");
         assert!(text.contains("changes back and forth"), "{text}");
+        // One line a person reads (issue 52: it was 600 characters); with its prefix
+        // "warning: increment N (t = T): " and every remedy, 266 on this cup.
+        let warning = text.lines().find(|l| l.contains("back and forth")).unwrap();
+        assert!(
+            warning.len() <= 280,
+            "{} characters: {warning}",
+            warning.len()
+        );
         assert_eq!(
             text.contains("status_prediction: 8"),
             prediction == 0,

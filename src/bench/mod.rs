@@ -359,6 +359,10 @@ fn measure(
     threads: usize,
 ) -> Result<Measurement> {
     let text = std::fs::read_to_string(script).map_err(|e| Error::io(script, e))?;
+    // The run's folder is the bench's own (a --work-dir used again holds the last
+    // measurement); cleared here rather than with --overwrite, which a baseline binary from
+    // before that option would refuse.
+    crate::output::clear_previous_outputs(out)?;
     let (sets, sets_left_out) = split_sets(&case.sets, &text);
     let mut command = std::process::Command::new(binary);
     command

@@ -19,7 +19,9 @@ pub mod fld_chart;
 mod folder;
 pub mod formability;
 mod line_chart;
+mod previous_run;
 mod pvd;
+mod run_settings;
 mod shell_layers;
 mod summary;
 pub mod svg;
@@ -32,6 +34,9 @@ pub use self::blank_frame::{frame, Configuration};
 pub use self::cadence::{Cadence, DEFAULT_FRAMES};
 pub use self::csv::HistoryCsv;
 pub use self::folder::{FolderLock, OutputFolder, LOCK_FILE};
+pub use self::previous_run::{
+    clear_previous_outputs, describe as describe_outputs, previous_outputs,
+};
 pub use self::pvd::{PvdEntry, PvdSeries};
 pub use self::run::{OutputOptions, RunOutput, Units};
 pub use self::summary::{write_summary, SUMMARY_FILE};

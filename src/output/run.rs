@@ -510,6 +510,7 @@ impl RunOutput {
                 "with_approximate_local_solves": sim.phase_times.approximate_evaluations,
             },
             "kinematics": settings.kinematics.name(),
+            "settings": super::run_settings::settings_json(settings),
             "nodes": sim.model.mesh.nodes.len(),
             "elements": sim.model.mesh.hexes.len(),
             "contact": {

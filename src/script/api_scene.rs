@@ -20,7 +20,7 @@ pub struct ScriptMaterial(pub Arc<dyn Material>);
 pub struct ScriptSurface(pub Arc<dyn RigidSurface>);
 
 pub fn register(engine: &mut Engine, host: std::rc::Rc<super::HostOptions>) {
-    register_mesh(engine, host.limits.clone());
+    register_mesh(engine, &host);
     register_material(engine);
     register_tools(engine);
     register_friction(engine, host);
@@ -142,7 +142,8 @@ fn block_cells(cells: &Array, limits: &super::limits::Limits) -> ScriptResult<[u
     Ok(n)
 }
 
-fn register_mesh(engine: &mut Engine, limits: super::limits::Limits) {
+fn register_mesh(engine: &mut Engine, host: &std::rc::Rc<super::HostOptions>) {
+    let limits = host.limits.clone();
     engine.register_type_with_name::<Mesh>("Mesh");
     let l = limits.clone();
     engine.register_fn(
@@ -190,9 +191,13 @@ fn register_mesh(engine: &mut Engine, limits: super::limits::Limits) {
         },
     );
     // Named node set from a predicate |x, y, z| -> bool over reference coordinates.
+    let h = host.clone();
     engine.register_fn(
         "select",
-        |ctx: NativeCallContext, m: &mut Mesh, name: &str, pred: FnPtr| -> ScriptResult<i64> {
+        move |ctx: NativeCallContext, m: &mut Mesh, name: &str, pred: FnPtr| -> ScriptResult<i64> {
+            if !h.simulations.is_empty() {
+                h.late_sets.borrow_mut().insert(name.to_string());
+            }
             let mut chosen = Vec::new();
             for (i, p) in m.nodes.iter().enumerate() {
                 if pred.call_within_context::<bool>(&ctx, (p.x, p.y, p.z))? {

@@ -24,6 +24,8 @@ pub struct SimState {
     frames: FrameKnobs,
     /// Write checkpoints/checkpoint_NNNN.json every this many increments (0: never).
     checkpoint_every: usize,
+    /// The script set `kinematics` (see [`SimState::refuse_default_small_strain`]).
+    kinematics_chosen: bool,
     host: Rc<HostOptions>,
     started: Option<Instant>,
     /// Wall time of the run, fixed when it finished (post-processing does not count).
@@ -105,12 +107,50 @@ fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementRepo
         }
     }
     s.borrow_mut().record_step(&report)?;
+    s.borrow().refuse_default_small_strain()?;
     if let Some(missed) = &report.until_missed {
         // Recorded (history row, frame), then the run stops: the next step would start
         // from a state its process did not reach.
         return runtime_error(missed.clone());
     }
     Ok(report)
+}
+
+/// How the solver's warning about small-strain kinematics past their range begins
+/// (`kinematics_check::small_strain_warning`).
+const SMALL_STRAIN_WARNING: &str = "small-strain kinematics";
+
+impl SimState {
+    /// A run on the default kinematics ("small": the script never chose) whose largest
+    /// rotation has passed the small-strain range (`SMALL_STRAIN_ROTATION_LIMIT`, 0.1 rad:
+    /// a spurious strain θ²/2 several times a metal's yield strain) stops here with the
+    /// fix, rather than finishing with results that look plausible and are wrong. A script
+    /// that sets `kinematics: "small"` itself keeps the solver's warning instead.
+    fn refuse_default_small_strain(&self) -> ScriptResult<()> {
+        use crate::solver::simulation::kinematics_check as check;
+        let Some(sim) = self.sim.as_ref() else {
+            return Ok(());
+        };
+        if self.kinematics_chosen
+            || sim.model.settings.kinematics != crate::element::StrainTheory::Small
+        {
+            return Ok(());
+        }
+        let (angle, _) = check::largest_rotation(sim.points());
+        if angle < check::SMALL_STRAIN_ROTATION_LIMIT {
+            return Ok(());
+        }
+        runtime_error(format!(
+            "rotation of {angle:.3} rad at t = {} is past the range of the default small-strain \
+             kinematics ({} rad)\n  small strain reads a rotation θ as a stretch of about \
+             θ²/2 = {:.1e}: stresses and plastic flow would be wrong from here on\n  fix: \
+             sim.settings(#{{ kinematics: \"finite\" }}) for forming (large rotations and \
+             strains), or kinematics: \"small\" to keep the small-strain theory knowingly",
+            crate::output::significant(sim.time(), 6),
+            check::SMALL_STRAIN_ROTATION_LIMIT,
+            0.5 * angle * angle
+        ))
+    }
 }
 
 /// A tool given an empty node set can never touch the body: it would run with zero force.
@@ -194,6 +234,11 @@ impl std::fmt::Debug for Simulations {
 impl Simulations {
     fn add(&self, sim: ScriptSim) {
         self.0.borrow_mut().push(sim);
+    }
+
+    /// Whether the script has created no simulation yet.
+    pub fn is_empty(&self) -> bool {
+        self.0.borrow().is_empty()
     }
 
     /// Forgets the simulations of an earlier script.
@@ -500,7 +545,10 @@ impl SimState {
         let fmt = |x: f64| crate::output::significant(x, 6);
         let sim = self.sim.as_ref().expect("started");
         if self.host.warnings {
-            for w in &report.warnings {
+            // The default kinematics past their range is an error (below), not a warning.
+            let refused =
+                |w: &&String| !self.kinematics_chosen && w.starts_with(SMALL_STRAIN_WARNING);
+            for w in report.warnings.iter().filter(|w| !refused(w)) {
                 let line = format!(
                     "warning: increment {} (t = {}): {w}",
                     report.index,
@@ -723,6 +771,7 @@ fn new_simulation(
         frames: FrameKnobs::default(),
         checkpoint_every: 0,
         max_increments: host.limits.max_increments,
+        kinematics_chosen: false,
     };
     apply_settings(&mut model.settings, &mut knobs, &host.base_settings)?;
     let sim = Rc::new(RefCell::new(SimState {
@@ -731,6 +780,7 @@ fn new_simulation(
         output: None,
         frames: knobs.frames,
         checkpoint_every: knobs.checkpoint_every,
+        kinematics_chosen: knobs.kinematics_chosen,
         host: host.clone(),
         started: None,
         wall_time: None,
@@ -753,6 +803,7 @@ fn change_settings(s: &mut ScriptSim, spec: &Map) -> ScriptResult<()> {
         frames: st.frames.clone(),
         checkpoint_every: st.checkpoint_every,
         max_increments: st.host.limits.max_increments,
+        kinematics_chosen: st.kinematics_chosen,
     };
     if let Some(model) = st.model.as_mut() {
         apply_settings(&mut model.settings, &mut knobs, spec)?;
@@ -765,6 +816,7 @@ fn change_settings(s: &mut ScriptSim, spec: &Map) -> ScriptResult<()> {
     }
     st.frames = knobs.frames;
     st.checkpoint_every = knobs.checkpoint_every;
+    st.kinematics_chosen = knobs.kinematics_chosen;
     Ok(())
 }
 

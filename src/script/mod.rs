@@ -70,6 +70,50 @@ pub struct HostOptions {
     pub limits: limits::Limits,
     /// The script's own time (the engine sets a fresh one).
     pub clock: Rc<limits::ScriptClock>,
+    /// What [`run_file`] does with an earlier run's files in the output folder.
+    pub earlier_outputs: EarlierOutputs,
+    /// Names of node sets `mesh.select` made after a simulation existed: a simulation holds
+    /// the copy of the mesh it was created with, so such a set never reaches it; an error
+    /// that names one as unknown says so ([`explain_late_sets`]).
+    pub late_sets: Rc<std::cell::RefCell<std::collections::BTreeSet<String>>>,
+}
+
+/// What a run does with the files an earlier run left in its output folder (the engine's
+/// own files only: `crate::output::previous_outputs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EarlierOutputs {
+    /// Leave them (a restart continues the run in its folder; library callers that manage
+    /// their folders themselves).
+    #[default]
+    Keep,
+    /// Refuse the run, naming the folder, the files and `--overwrite` (`tribo run`).
+    Refuse,
+    /// Remove them before the run starts (`tribo run --overwrite`, the REPL's own folder).
+    Overwrite,
+}
+
+/// Applies `policy` to the earlier run's files in `dir` (to be called with the folder's
+/// lock held, so that no run is writing them).
+pub fn prepare_output_folder(dir: &Path, policy: EarlierOutputs) -> Result<()> {
+    if policy == EarlierOutputs::Keep {
+        return Ok(());
+    }
+    let files = crate::output::previous_outputs(dir)?;
+    if files.is_empty() {
+        return Ok(());
+    }
+    if policy == EarlierOutputs::Overwrite {
+        crate::output::clear_previous_outputs(dir)?;
+        return Ok(());
+    }
+    Err(Error::Input(format!(
+        "the output folder {} holds an earlier run's results ({})\n  \
+         add --overwrite to remove them first (only the files a run writes: history.csv, \
+         summary.json, *.pvd, charts, frames/*.vtu, checkpoints/*.json),\n  \
+         or choose another --out, or continue that run with --restart CHECKPOINT",
+        dir.display(),
+        crate::output::describe_outputs(dir, &files)
+    )))
 }
 
 impl Default for HostOptions {
@@ -91,6 +135,8 @@ impl Default for HostOptions {
             max_read_bytes: crate::paths::DEFAULT_MAX_READ_BYTES,
             limits: limits::Limits::default(),
             clock: Rc::default(),
+            earlier_outputs: EarlierOutputs::Keep,
+            late_sets: Rc::default(),
         }
     }
 }
@@ -173,6 +219,24 @@ fn register_checks(engine: &mut Engine) {
             }
         },
     );
+}
+
+/// `message`, and when it names as unknown a node set that `mesh.select` made after a
+/// simulation was created, why, on a line of its own: a simulation holds the copy of the
+/// mesh it was created with.
+pub fn explain_late_sets(host: &HostOptions, message: String) -> String {
+    let late = host.late_sets.borrow();
+    let named = late
+        .iter()
+        .find(|name| message.contains(&format!("node set = \"{name}\" is unknown")));
+    match named {
+        Some(name) => format!(
+            "{message}\n  mesh.select(\"{name}\", ...) ran after simulation(mesh, ...): a \
+             simulation takes its own copy of the mesh when it is created, so a set selected \
+             later never reaches it; select every set before simulation(...)"
+        ),
+        None => message,
+    }
 }
 
 /// Formats a Rhai error as "file:line:column: message". An error inside a function of
@@ -274,17 +338,22 @@ pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
 /// checkpoint that no simulation used is an error.
 pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions) -> Result<()> {
     host.simulations.clear();
+    host.late_sets.borrow_mut().clear();
     let engine = engine(host, path.parent());
     let ast = compile(&engine, path)?;
     // The --allow-read folders exist (the engine would otherwise refuse every read quietly).
     read_policy(host, path.parent())?;
     // Held to the end of the run: a second run into the same folder is refused.
     let _lock = crate::output::FolderLock::acquire(&host.out_dir)?;
+    prepare_output_folder(&host.out_dir, host.earlier_outputs)?;
     let ast = apply_overrides(&engine, ast, overrides, path)?;
     let mut scope = Scope::new();
     let outcome = engine
         .run_ast_with_scope(&mut scope, &ast)
-        .map_err(|e| Error::Script(describe_error(&path.display().to_string(), &e)))
+        .map_err(|e| {
+            let text = describe_error(&path.display().to_string(), &e);
+            Error::Script(explain_late_sets(host, text))
+        })
         .and_then(|()| host.simulations.close());
     let outcome = outcome.and_then(|()| match &host.restart {
         Some(file) if !host.restart_used.get() => Err(Error::Input(format!(

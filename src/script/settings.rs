@@ -65,6 +65,9 @@ pub(super) struct Knobs {
     pub(super) checkpoint_every: usize,
     /// `--max-increments`: a larger `increments` setting is refused.
     pub(super) max_increments: usize,
+    /// Whether the script chose `kinematics` itself (the default "small" is refused past
+    /// the small-strain range; a chosen one only warned about).
+    pub(super) kinematics_chosen: bool,
 }
 
 /// One key of `sim.settings(#{ ... })`.
@@ -240,8 +243,9 @@ pub(super) const SETTINGS: &[Setting] = &[
         Ok(())
     }),
     // Elements.
-    setting("kinematics", "\"finite\"", |s, _, v| {
+    setting("kinematics", "\"finite\"", |s, k, v| {
         s.kinematics = lift(StrainTheory::from_name(&v.text()))?;
+        k.kinematics_chosen = true;
         Ok(())
     }),
     setting("fbar", "false", |s, _, v| {
@@ -542,6 +546,7 @@ mod tests {
             frames: FrameKnobs::default(),
             checkpoint_every: 0,
             max_increments: usize::MAX,
+            kinematics_chosen: false,
         }
     }
 

@@ -93,6 +93,8 @@ impl Sweep {
             "--out".into(),
             self.run_dir(i).display().to_string(),
             "--quiet".into(),
+            // The run's folder is the sweep's own: running the sweep again replaces it.
+            "--overwrite".into(),
         ];
         for (c, v) in self.table.columns.iter().zip(&self.table.rows[i]) {
             args.push("--set".into());

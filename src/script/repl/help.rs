@@ -58,7 +58,121 @@ pub fn function_help(catalogue: &Catalogue, name: &str) -> String {
         text.push_str("\n  (not described in docs/script-api.md)");
     }
     for (call, meaning) in rows {
-        text.push_str(&format!("\n  {call}: {meaning}"));
+        let call = call.replace('`', "");
+        let items = keyed_items(&meaning);
+        if items.len() > 3 {
+            // A list of keys (sim.settings): a table, one key per row, wrapped.
+            text.push_str(&format!("\n  {call}:"));
+            text.push_str(&table(&items));
+        } else {
+            let row = format!("  {call}: {}", meaning.replace('`', ""));
+            text.push_str(&wrap(&row, 4));
+        }
+    }
+    text
+}
+
+/// Width of the help's lines.
+const WIDTH: usize = 100;
+
+/// A meaning cell that lists keys (`key` (what), `key`: what; ...) split into (key, what),
+/// at the commas and semicolons outside brackets that start a new `key`. A sentence after
+/// the list is kept as a row with no key. Empty unless the cell starts with a key.
+fn keyed_items(meaning: &str) -> Vec<(String, String)> {
+    let mut items: Vec<(String, String)> = Vec::new();
+    let mut current = String::new();
+    let mut depth = 0i32;
+    let chars: Vec<char> = meaning.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        depth += match c {
+            '(' | '[' | '{' => 1,
+            ')' | ']' | '}' => -1,
+            _ => 0,
+        };
+        let next_key = chars.get(i + 1) == Some(&' ') && chars.get(i + 2) == Some(&'`');
+        let sentence = c == '.'
+            && chars.get(i + 1) == Some(&' ')
+            && chars.get(i + 2).is_some_and(|c| c.is_uppercase());
+        if depth == 0 && ((",;".contains(c) && next_key) || sentence) {
+            if sentence {
+                current.push('.');
+            }
+            items.push(split_key(&current));
+            current.clear();
+            i += 2;
+            continue;
+        }
+        current.push(c);
+        i += 1;
+    }
+    items.push(split_key(&current));
+    if items.first().is_none_or(|(k, _)| k.is_empty()) {
+        return Vec::new();
+    }
+    items
+}
+
+/// "`key` (what)" -> ("key", "(what)"); text without a leading key -> ("", text).
+fn split_key(item: &str) -> (String, String) {
+    let item = item.trim();
+    match item.strip_prefix('`').and_then(|r| r.split_once('`')) {
+        Some((key, rest)) => (
+            key.to_string(),
+            rest.trim_start_matches(':').trim().replace('`', ""),
+        ),
+        None => (String::new(), item.replace('`', "")),
+    }
+}
+
+/// `text` as lines of at most [`WIDTH`] (a longer word alone on its line), each after the
+/// first indented by `indent`; every line starts with a newline.
+fn wrap(text: &str, indent: usize) -> String {
+    let lead = text.len() - text.trim_start().len();
+    let mut out = String::new();
+    let mut line = " ".repeat(lead);
+    for word in text.split_whitespace() {
+        if !line.trim().is_empty() && line.len() + 1 + word.len() > WIDTH {
+            out.push('\n');
+            out.push_str(&line);
+            line = " ".repeat(indent);
+        }
+        if !line.trim().is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    out.push('\n');
+    out.push_str(&line);
+    out
+}
+
+/// Rows `  key   what`, the meanings wrapped at [`WIDTH`] under their column.
+fn table(items: &[(String, String)]) -> String {
+    let column = items
+        .iter()
+        .map(|(k, _)| k.len())
+        .max()
+        .unwrap_or(0)
+        .min(30)
+        + 4;
+    let mut text = String::new();
+    for (key, what) in items {
+        let mut line = format!("    {key:<w$}", w = column - 2);
+        for word in what.split_whitespace() {
+            if line.len() + 1 + word.len() > WIDTH && line.trim().len() > key.len() {
+                text.push('\n');
+                text.push_str(&line);
+                line = " ".repeat(column + 2);
+            }
+            if !line.ends_with(' ') {
+                line.push(' ');
+            }
+            line.push_str(word);
+        }
+        text.push('\n');
+        text.push_str(&line);
     }
     text
 }
@@ -73,12 +187,7 @@ fn reference_rows(name: &str) -> Vec<(String, String)> {
             let cells = split_row(l);
             let (call, meaning) = (cells.first()?, cells.get(1)?);
             let documented = names_in(call).any(|n| n == name);
-            documented.then(|| {
-                (
-                    call.replace('`', "").replace("\\|", "|"),
-                    meaning.replace('`', "").replace("\\|", "|"),
-                )
-            })
+            documented.then(|| (call.replace("\\|", "|"), meaning.replace("\\|", "|")))
         })
         .collect()
 }
@@ -150,6 +259,42 @@ mod tests {
         assert!(m.contains("mesh.n_nodes"), "{m}");
         assert!(function_help(&catalogue, "tool_forse").starts_with("no function named"));
         assert!(function_help(&catalogue, "force").contains("tool_force"));
+    }
+
+    /// `:help settings` is a table: one key per row, every line within the width (a
+    /// word longer than the line aside); it was one 3,000-character paragraph.
+    #[test]
+    fn help_on_settings_is_a_table_of_keys() {
+        let catalogue = Catalogue::of(&engine(&HostOptions::default(), None));
+        let h = function_help(&catalogue, "settings");
+        let lines: Vec<&str> = h.lines().collect();
+        let long: Vec<&&str> = lines
+            .iter()
+            .filter(|l| l.len() > WIDTH && l.trim().contains(' '))
+            .collect();
+        assert!(long.is_empty(), "lines over {WIDTH}: {long:?}");
+        // The keys the reference's sim.settings rows list (others, such as output_interval,
+        // are documented in rows of their own), one row each.
+        let rows = lines
+            .iter()
+            .filter(|l| l.starts_with("    ") && !l.starts_with("     "));
+        assert!(rows.count() >= 30, "{h}");
+        for key in [
+            "increments",
+            "end_time",
+            "kinematics",
+            "linear_solver",
+            "step_control",
+            "dt_min",
+            "anti_cycling",
+            "checkpoint_every",
+        ] {
+            let row = format!("    {key} ");
+            assert!(
+                lines.iter().any(|l| l.starts_with(&row)),
+                "no row for {key} in:\n{h}"
+            );
+        }
     }
 
     #[test]

@@ -200,7 +200,10 @@ pub fn outcome_line(
                 times.join(", ")
             )
         }
-        Err(e) => format!("error: {}", describe_error("<repl>", e)),
+        Err(e) => format!(
+            "error: {}",
+            super::explain_late_sets(host, describe_error("<repl>", e))
+        ),
     }
 }
 

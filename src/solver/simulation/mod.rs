@@ -477,7 +477,6 @@ impl Simulation {
             report.warnings.push(cycling_warning(
                 &self.model,
                 &trial.cycling,
-                report.index,
                 self.model.settings.stepping.anti_cycling,
             ));
         }
@@ -768,42 +767,39 @@ fn check_releases(model: &Model) -> Result<()> {
     )))
 }
 
-/// The one warning of a run about contact-status cycling: where it happened first, whether
-/// the result is sound, and what to try.
+/// The one warning of a run about contact-status cycling, on one line: how many nodes, that
+/// the result is sound, what to try, where the count per increment is. (Its increment and
+/// time are in the prefix the script layer prints before every warning.)
 fn cycling_warning(
     model: &Model,
     cycling: &[CyclingNode],
-    increment: usize,
     treatment: crate::solver::settings::AntiCycling,
 ) -> String {
-    const SHOWN: usize = 5;
-    let nodes: Vec<String> = cycling
-        .iter()
-        .take(SHOWN)
-        .map(|n| {
-            format!(
-                "{}:{} ({} flips)",
-                model.contacts[n.tool].tool.name, n.node, n.flips
-            )
-        })
+    // One line a person reads: what happens, that it costs only iterations (each increment
+    // is accepted only when the unmodified friction law holds to the Newton tolerances),
+    // what to try if it costs many, and where the count per increment is.
+    const SHOWN: usize = 2;
+    let nodes: Vec<String> = (cycling.iter().take(SHOWN))
+        .map(|n| format!("{}:{}", model.contacts[n.tool].tool.name, n.node))
         .collect();
     let more = cycling.len().saturating_sub(SHOWN);
+    let mut remedies = vec!["smaller steps"];
+    if model.settings.status_prediction == 0 {
+        remedies.push("status_prediction: 8");
+    }
+    if treatment == crate::solver::settings::AntiCycling::Off {
+        remedies.push("anti_cycling: \"freeze\"");
+    }
     format!(
-        "from increment {increment} on, the contact status of some barely touching nodes changes back and forth during Newton's iterations (here {} node(s): {}{}). \
-         Each increment is still accepted only when the unmodified friction law holds to the Newton tolerances, so the results are sound; cycling costs iterations. \
-         If increments take many iterations or are cut back, try smaller increments (increments, or step_control: \"adaptive\"){}{}. \
-         Not repeated: the count per increment is the column cycling_nodes of history.csv.",
+        "the status of {} contact node(s) ({}{}) changes back and forth in Newton: results \
+         unaffected, costs iterations; if many: {} (history.csv: cycling_nodes)",
         cycling.len(),
         nodes.join(", "),
-        if more > 0 { format!(" and {more} more") } else { String::new() },
-        if model.settings.status_prediction == 0 {
-            ", status_prediction: 8 (each Newton step solved again with the nodes it carries into or out of touch linearised on their new status: fewer iterations, one more linear solve per re-solve; docs/convergence.md)"
+        if more > 0 {
+            format!(", +{more}")
         } else {
-            ""
+            String::new()
         },
-        match treatment {
-            crate::solver::settings::AntiCycling::Off => ", or anti_cycling: \"freeze\"",
-            _ => "",
-        }
+        remedies.join(", "),
     )
 }
