@@ -1,0 +1,339 @@
+//! Issue 53: tool-side fields (src/tool/surface_fields.rs, src/solver/simulation/tool_fields.rs).
+//!
+//! - The transfer alone, on a block's contact face laid on a flat patch and wrapped on a
+//!   cylinder patch, with a uniform tool-side pressure and slip: Archard wear `c p s`,
+//!   pressure `p` and sliding distance `s` in every fully covered cell to 1e-10 relative;
+//!   the tool-side work integral equal to the nodes' dissipation to 1e-10.
+//! - A real run (a roller of cylinder patches pressed and dragged over an elastic block):
+//!   after every increment the tool-side work integral equals the energy balance's frictional
+//!   dissipation to 1e-10 relative; a restart from a checkpoint continues the fields bit for
+//!   bit.
+
+mod common;
+
+use std::sync::Arc;
+use tribo::contact::{ContactNodeState, FrictionLaw};
+use tribo::geometry::{BezierPatch, PatchSurface, Vec3};
+use tribo::mesh::Mesh;
+use tribo::solver::simulation::checkpoint::Checkpoint;
+use tribo::solver::simulation::tool_fields::ContactFields;
+use tribo::solver::{Model, Simulation};
+use tribo::tool::surface_fields::NodeLoad;
+use tribo::tool::{FieldSpec, Pose, Tool, WearLaw};
+
+/// Archard's k and H of the tests (a tool steel's order of magnitude).
+const K: f64 = 2e-4;
+const H: f64 = 6000.0;
+
+/// A model holding `mesh` and a fixed tool on `patch` with fields of cell size `cell`,
+/// touching the nodes of "z-".
+fn model_on(mesh: Mesh, patch: BezierPatch, cell: f64) -> Model {
+    let mut model = Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
+    let mut tool = Tool::new("die", Arc::new(PatchSurface::new(vec![patch]).unwrap()));
+    tool.fields = Some(FieldSpec {
+        wear: WearLaw::archard(K, H).unwrap(),
+        cell: Some(cell),
+    });
+    model.add_tool(tool, "z-", None).unwrap();
+    model
+}
+
+/// Contact states with each candidate's foot on the tool (identity pose).
+fn states(model: &Model) -> Vec<ContactNodeState> {
+    let c = &model.contacts[0];
+    c.candidates
+        .iter()
+        .map(|&n| {
+            let p = c
+                .tool
+                .project(&Pose::identity(), &model.mesh.nodes[n], None)
+                .unwrap();
+            assert!(p.gap.abs() < 1e-12, "the contact face lies on the tool");
+            ContactNodeState {
+                hint: Some(p.hint),
+                ..Default::default()
+            }
+        })
+        .collect()
+}
+
+/// Deposits a uniform tool-side pressure `p` and slip `s` (mu = 0.3) for every node
+/// (normal force p times the node's footprint area on the tool), and returns the fields and
+/// the sum of the nodes' frictional work.
+fn uniform_load(model: &Model, p: f64, s: f64) -> (ContactFields, f64) {
+    let contact = &model.contacts[0];
+    let mut fields = ContactFields::new(contact, &model.mesh).unwrap().unwrap();
+    let states = states(model);
+    let position = |n: usize| model.mesh.nodes[n];
+    let pose = Pose::identity();
+    let pieces = fields.footprints(contact, &pose, position, &states, |_| true);
+    let loads: Vec<NodeLoad> = pieces
+        .iter()
+        .map(|pk| {
+            let force = p * fields.fields.footprint_area(pk);
+            NodeLoad {
+                work: 0.3 * force * s,
+                normal_force: force,
+                slip: s,
+            }
+        })
+        .collect();
+    let work = loads.iter().map(|l| l.work).sum();
+    fields.accumulate(contact, &pose, position, &states, &loads, 0.5);
+    (fields, work)
+}
+
+/// Checks the uniform fields in the cells whose four corners satisfy `inside`; returns
+/// how many cells that is. Partly covered cells get less, never more.
+fn check_uniform(
+    fields: &ContactFields,
+    patch: &BezierPatch,
+    inside: impl Fn(Vec3) -> bool,
+    p: f64,
+    s: f64,
+) -> usize {
+    let f = &fields.fields;
+    let grid = &f.grids[0];
+    let wear = K / H * p * s;
+    let mut covered = 0;
+    for c in 0..grid.len() {
+        let (i, j) = (c / grid.nv, c % grid.nv);
+        let corners = [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
+            .map(|(a, b)| patch.point(a as f64 / grid.nu as f64, b as f64 / grid.nv as f64));
+        let v = &f.values;
+        if corners.iter().all(|x| inside(*x)) {
+            covered += 1;
+            let rel = |a: f64, b: f64| (a - b).abs() / b;
+            assert!(
+                rel(v.wear[c], wear) < 1e-10,
+                "cell {c}: wear {} != {wear}",
+                v.wear[c]
+            );
+            assert!(
+                rel(v.peak_pressure[c], p) < 1e-10,
+                "cell {c}: pressure {}",
+                v.peak_pressure[c]
+            );
+            assert!(rel(v.pressure_time[c], 0.5 * p) < 1e-10, "cell {c}");
+            assert!(rel(v.slip[c], s) < 1e-10, "cell {c}: slip {}", v.slip[c]);
+        } else {
+            // 1e-12: the round-off of a sum of a few pieces.
+            assert!(
+                v.wear[c] <= wear * (1.0 + 1e-12),
+                "cell {c}: {} > {wear}",
+                v.wear[c]
+            );
+        }
+    }
+    covered
+}
+
+/// A 3 x 2 block (6 x 4 elements) on a flat 6 x 5 patch with cells of 0.2 that do not line
+/// up with the elements: Archard's k p s / H in the 10 x 5... fully covered cells.
+#[test]
+fn uniform_pressure_and_slip_on_a_flat_tool_give_archard_in_every_covered_cell() {
+    let (x0, y0) = (0.13, 0.27);
+    let mesh = Mesh::block(Vec3::new(x0, y0, 0.0), Vec3::new(3.0, 2.0, 0.5), [6, 4, 1]).unwrap();
+    let patch = BezierPatch::parallelogram(
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(6.0, 0.0, 0.0),
+        Vec3::new(0.0, 5.0, 0.0),
+    )
+    .unwrap();
+    let model = model_on(mesh, patch.clone(), 0.2);
+    let (p, s) = (80.0, 0.35);
+    let (fields, work) = uniform_load(&model, p, s);
+    let f = &fields.fields;
+    assert_eq!((f.grids[0].nu, f.grids[0].nv), (30, 25));
+    // The grid's area is the patch's: 30, exact on a flat patch.
+    let area: f64 = f.cell_areas().sum();
+    assert!((area - 30.0).abs() < 1e-12, "{area}");
+    let inside = |x: Vec3| x.x >= x0 && x.x <= x0 + 3.0 && x.y >= y0 && x.y <= y0 + 2.0;
+    let covered = check_uniform(&fields, &patch, inside, p, s);
+    // Cells of 0.2 inside [0.13, 3.13] x [0.27, 2.27]: x from 0.2 to 3.0 (14), y from 0.4
+    // to 2.2 (9).
+    assert_eq!(covered, 14 * 9);
+    let rel = (f.total_work() - work).abs() / work;
+    assert!(
+        rel < 1e-10,
+        "tool-side work {} vs the nodes' {work}",
+        f.total_work()
+    );
+    // On a flat tool the footprints are the nodes' tributary areas, so the total normal
+    // force is p times the block's face.
+    let force: f64 = f
+        .cell_areas()
+        .zip(&f.values.peak_pressure)
+        .map(|(a, p)| a * p)
+        .sum();
+    assert!((force - p * 6.0).abs() < 1e-10 * p * 6.0, "{force}");
+}
+
+/// The same block wrapped on a cylinder patch (radius 10, 60 degrees, axis along y): the
+/// fields follow the curved surface.
+#[test]
+fn uniform_pressure_and_slip_on_a_cylinder_give_archard_in_every_covered_cell() {
+    let radius = 10.0;
+    let block = Mesh::block(
+        Vec3::new(-2.9, 0.23, 0.0),
+        Vec3::new(6.0, 2.0, 0.5),
+        [12, 4, 1],
+    )
+    .unwrap();
+    // (x, y, z) -> arc length x around the axis at radius R + z.
+    let mut mesh = block.clone();
+    for node in &mut mesh.nodes {
+        let (theta, r) = (node.x / radius, radius + node.z);
+        *node = Vec3::new(r * theta.sin(), node.y, r * theta.cos());
+    }
+    let sweep = 60f64.to_radians();
+    // u from -30 degrees (about +z towards +x) over 60 degrees; v along y over 4.
+    let patch = BezierPatch::cylinder_patch(
+        Vec3::zeros(),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+        -0.5 * sweep,
+        sweep,
+        radius,
+        4.0,
+    )
+    .unwrap();
+    // The patch's outward normal at its middle is +z (the sheet lies outside).
+    let mid = patch.evaluate(0.5, 0.5);
+    let n = patch.normal(&mid).unwrap();
+    assert!(n.z > 0.999, "{n:?}");
+    let model = model_on(mesh, patch.clone(), 0.15);
+    let (p, s) = (80.0, 0.35);
+    let (fields, work) = uniform_load(&model, p, s);
+    let f = &fields.fields;
+    // The grid's area is the cylinder's R * sweep * 4, not a projection's; the bilinear
+    // metric errs by O(cell^2 / R^2) (measured below 1e-6 here).
+    let area: f64 = f.cell_areas().sum();
+    let exact = radius * sweep * 4.0;
+    assert!((area - exact).abs() < 1e-5 * exact, "{area} vs {exact}");
+    let inside = |x: Vec3| {
+        let arc = radius * x.x.atan2(x.z);
+        arc >= -2.9 && arc <= 3.1 && x.y >= 0.23 && x.y <= 2.23
+    };
+    let covered = check_uniform(&fields, &patch, inside, p, s);
+    assert!(covered > 200, "{covered} covered cells");
+    let rel = (f.total_work() - work).abs() / work;
+    assert!(
+        rel < 1e-10,
+        "tool-side work {} vs the nodes' {work}",
+        f.total_work()
+    );
+}
+
+/// A roller made of two 60-degree cylinder patches (radius 5, axis along y), pressed 0.1
+/// into an elastic block and dragged 3 along it with Coulomb 0.2 (the set-up of
+/// common::cylinder_drag_model with the analytic cylinder replaced by patches).
+fn roller_drag(increments: usize) -> Model {
+    let mut model = common::cylinder_drag_model(8.0, 2.0, 16, 3.0);
+    let axis = Vec3::new(2.0, -0.5, 2.0 + 5.0 + 0.02);
+    let patches = (0..2)
+        .map(|k| {
+            BezierPatch::cylinder_patch(
+                axis,
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(0.0, 0.0, -1.0),
+                (-60.0 + 60.0 * k as f64).to_radians(),
+                60f64.to_radians(),
+                5.0,
+                2.0,
+            )
+            .unwrap()
+        })
+        .collect();
+    let contact = &mut model.contacts[0];
+    contact.tool.surface = Arc::new(PatchSurface::new(patches).unwrap());
+    contact.tool.friction = FrictionLaw::coulomb(0.2).unwrap();
+    contact.tool.fields = Some(FieldSpec {
+        wear: WearLaw::archard(K, H).unwrap(),
+        cell: None,
+    });
+    model.settings.increments = increments;
+    model
+}
+
+#[test]
+fn tool_side_work_equals_the_frictional_dissipation_in_a_drag() {
+    let mut sim = Simulation::new(roller_drag(12)).unwrap();
+    let mut checked = 0;
+    while !sim.is_finished() {
+        sim.step().unwrap();
+        let sheet = sim.energy().frictional_dissipation[0];
+        let tool = sim.tool_fields(0).unwrap().total_work();
+        if sheet > 0.0 {
+            checked += 1;
+            assert!(
+                (tool - sheet).abs() <= 1e-10 * sheet,
+                "t = {}: tool {tool} vs sheet {sheet}",
+                sim.time()
+            );
+        }
+    }
+    assert!(checked >= 6, "{checked} increments with friction");
+    let f = sim.tool_fields(0).unwrap();
+    let max_wear = f.values.wear.iter().cloned().fold(0.0, f64::max);
+    let peak = f.values.peak_pressure.iter().cloned().fold(0.0, f64::max);
+    println!(
+        "drag: tool-side work {}, max wear {max_wear:e}, peak pressure {peak}",
+        f.total_work()
+    );
+    // The roller's rim slides over the block, so wear and pressure are where it touched.
+    assert!(max_wear > 0.0 && peak > 0.0);
+}
+
+/// A run stopped after 6 of 12 increments, written to a checkpoint and continued in a new
+/// simulation ends with the uninterrupted run's fields, bit for bit.
+#[test]
+fn tool_side_fields_restart_bit_for_bit() {
+    let mut whole = Simulation::new(roller_drag(12)).unwrap();
+    whole.run(|_, _| Ok(())).unwrap();
+    let mut first = Simulation::new(roller_drag(12)).unwrap();
+    for _ in 0..6 {
+        first.step().unwrap();
+    }
+    let json = Checkpoint::of(&first, Vec::new()).to_json().unwrap();
+    let mut second = Simulation::new(roller_drag(12)).unwrap();
+    Checkpoint::from_json(&json, "test")
+        .unwrap()
+        .restore(&mut second)
+        .unwrap();
+    assert_eq!(
+        second.tool_fields(0).unwrap().values,
+        first.tool_fields(0).unwrap().values
+    );
+    second.run(|_, _| Ok(())).unwrap();
+    let (a, b) = (
+        &whole.tool_fields(0).unwrap().values,
+        &second.tool_fields(0).unwrap().values,
+    );
+    assert!(a.wear.iter().any(|&w| w > 0.0));
+    assert_eq!(a, b);
+    // A model without fields refuses the checkpoint with them, naming the tool.
+    let mut model = roller_drag(12);
+    model.contacts[0].tool.fields = None;
+    let mut plain = Simulation::new(model).unwrap();
+    let err = Checkpoint::from_json(&json, "test")
+        .unwrap()
+        .restore(&mut plain)
+        .unwrap_err();
+    assert!(err.to_string().contains("'roller'"), "{err}");
+}
+
+/// Fields on an analytic surface are refused with the tool's name.
+#[test]
+fn fields_on_an_analytic_tool_are_refused() {
+    let mut model = common::cylinder_drag_model(8.0, 2.0, 16, 3.0);
+    model.contacts[0].tool.fields = Some(FieldSpec {
+        wear: WearLaw::archard(K, H).unwrap(),
+        cell: None,
+    });
+    let err = Simulation::new(model).err().unwrap().to_string();
+    assert!(
+        err.contains("'roller'") && err.contains("Bézier patches"),
+        "{err}"
+    );
+}
