@@ -337,3 +337,49 @@ fn fields_on_an_analytic_tool_are_refused() {
         "{err}"
     );
 }
+
+/// The cylindrical cup script (scripts/cylindrical_cup.rhai, quarter, coarse default mesh)
+/// with `wear = true`, 6 mm of punch travel through the command line: for every tool the
+/// tool-side work in summary.json equals the tool's frictional dissipation to 1e-8
+/// relative (by construction to round-off; summary.json's numbers round-trip exactly), and
+/// the die's frames carry the wear field.
+#[test]
+fn cup_stroke_tool_side_work_equals_the_dissipation_on_every_tool() {
+    let out = common::TestDir::new(&format!("tribo_tool_fields_cup_{}", std::process::id()));
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .current_dir(root)
+        .args(["run", "scripts/cylindrical_cup.rhai", "--quiet", "--out"])
+        .arg(&*out)
+        .args(["--set", "charts=false", "--set", "wear=true", "--set", "travel=6.0"])
+        .status()
+        .expect("tribo runs");
+    assert!(status.success());
+    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let (mut sheet, mut tools) = (0.0, 0.0);
+    for name in ["punch", "die", "blankholder"] {
+        let tool = &summary["tools"][name];
+        let dissipation = tool["frictional_dissipation"].as_f64().unwrap();
+        let fields = &tool["tool_fields"];
+        let work = fields["total_work"].as_f64().unwrap();
+        println!("{name}: dissipation {dissipation}, tool-side work {work}, max wear {} at {}, peak pressure {}",
+            fields["max_wear_depth"], fields["max_wear_at"], fields["peak_pressure"]);
+        assert!((work - dissipation).abs() <= 1e-8 * dissipation.abs().max(1e-300), "{name}: {work} vs {dissipation}");
+        sheet += dissipation;
+        tools += work;
+    }
+    assert!(sheet > 0.0 && (tools - sheet).abs() <= 1e-8 * sheet);
+    // The die (drawn over its entry radius) wears; its wear lies on the die's surface.
+    let die = &summary["tools"]["die"]["tool_fields"];
+    assert!(die["max_wear_depth"].as_f64().unwrap() > 0.0);
+    let frames: Vec<_> = std::fs::read_dir(out.join("frames"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with("_die.vtu"))
+        .collect();
+    assert!(!frames.is_empty());
+    let last = frames.iter().max().unwrap();
+    let vtu = std::fs::read_to_string(last).unwrap();
+    assert!(vtu.contains("tool_wear_depth") && vtu.contains("tool_work_per_area"));
+}

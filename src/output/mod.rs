@@ -23,6 +23,7 @@ mod pvd;
 mod shell_layers;
 mod summary;
 pub mod svg;
+mod tool_fields;
 mod tool_frame;
 mod vtk;
 

@@ -341,7 +341,14 @@ impl RunOutput {
         let mut tool_files = files[1..].iter();
         let region = tool_frame::DisplayRegion::around(&sim.model.mesh.nodes);
         for (c, contact) in sim.model.contacts.iter().enumerate() {
-            if let Some(tool) = tool_frame::tool_frame(&contact.tool, &sim.tool_pose(c), &region) {
+            let pose = sim.tool_pose(c);
+            // A tool with tool-side fields is drawn on its field grid, carrying the fields.
+            let with_fields = (sim.tool_fields(c))
+                .zip(contact.tool.surface.as_patch_surface())
+                .map(|(f, surface)| super::tool_fields::frame(surface, f, &pose));
+            if let Some(tool) =
+                with_fields.or_else(|| tool_frame::tool_frame(&contact.tool, &pose, &region))
+            {
                 let (_, file) = tool_files.next().expect("one file per shown tool");
                 write_vtu(&self.folder.resolve_for_write(file)?, &tool)?;
             }
@@ -456,6 +463,9 @@ impl RunOutput {
                         "friction": contact.tool.friction.describe(),
                         "work_measure": contact.tool.friction.bernstein().map(|l| l.measure().name()),
                         "frictional_dissipation": sim.energy().frictional_dissipation.get(c),
+                        "tool_fields": (sim.tool_fields(c))
+                            .zip(contact.tool.surface.as_patch_surface())
+                            .map(|(f, surface)| super::tool_fields::summary(surface, f)),
                         "candidate_nodes": contact.candidates.len(),
                         "offset": sim.tool_offset(c),
                         "position": <[f64; 3]>::from(sim.tool_position(c)),
