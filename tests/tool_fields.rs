@@ -351,7 +351,14 @@ fn cup_stroke_tool_side_work_equals_the_dissipation_on_every_tool() {
         .current_dir(root)
         .args(["run", "scripts/cylindrical_cup.rhai", "--quiet", "--out"])
         .arg(&*out)
-        .args(["--set", "charts=false", "--set", "wear=true", "--set", "travel=6.0"])
+        .args([
+            "--set",
+            "charts=false",
+            "--set",
+            "wear=true",
+            "--set",
+            "travel=6.0",
+        ])
         .status()
         .expect("tribo runs");
     assert!(status.success());
@@ -365,7 +372,10 @@ fn cup_stroke_tool_side_work_equals_the_dissipation_on_every_tool() {
         let work = fields["total_work"].as_f64().unwrap();
         println!("{name}: dissipation {dissipation}, tool-side work {work}, max wear {} at {}, peak pressure {}",
             fields["max_wear_depth"], fields["max_wear_at"], fields["peak_pressure"]);
-        assert!((work - dissipation).abs() <= 1e-8 * dissipation.abs().max(1e-300), "{name}: {work} vs {dissipation}");
+        assert!(
+            (work - dissipation).abs() <= 1e-8 * dissipation.abs().max(1e-300),
+            "{name}: {work} vs {dissipation}"
+        );
         sheet += dissipation;
         tools += work;
     }

@@ -455,17 +455,12 @@ impl RunOutput {
             .enumerate()
             .map(|(c, contact)| {
                 let f = sim.tool_force(c);
-                (
-                    contact.tool.name.clone(),
-                    serde_json::json!({
+                let mut entry = serde_json::json!({
                         "final_force": [f.x, f.y, f.z],
                         "surface": contact.tool.surface.describe(),
                         "friction": contact.tool.friction.describe(),
                         "work_measure": contact.tool.friction.bernstein().map(|l| l.measure().name()),
                         "frictional_dissipation": sim.energy().frictional_dissipation.get(c),
-                        "tool_fields": (sim.tool_fields(c))
-                            .zip(contact.tool.surface.as_patch_surface())
-                            .map(|(f, surface)| super::tool_fields::summary(surface, f)),
                         "candidate_nodes": contact.candidates.len(),
                         "offset": sim.tool_offset(c),
                         "position": <[f64; 3]>::from(sim.tool_position(c)),
@@ -473,8 +468,15 @@ impl RunOutput {
                             "axis": [fc.axis.x, fc.axis.y, fc.axis.z],
                             "scheduled_force": fc.force.value(sim.time()),
                         })),
-                    }),
-                )
+                    });
+                // Only a tool with fields has the entry, so that other runs' summaries (and
+                // the columns `tribo sweep collect` makes of them) are unchanged.
+                if let Some((fields, surface)) =
+                    (sim.tool_fields(c)).zip(contact.tool.surface.as_patch_surface())
+                {
+                    entry["tool_fields"] = super::tool_fields::summary(surface, fields);
+                }
+                (contact.tool.name.clone(), entry)
             })
             .collect();
         let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();

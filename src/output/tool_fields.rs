@@ -61,10 +61,11 @@ pub fn frame(surface: &PatchSurface, fields: &ToolFields, pose: &Pose) -> Frame 
 pub fn summary(surface: &PatchSurface, fields: &ToolFields) -> serde_json::Value {
     let v = &fields.values;
     let largest = |values: &[f64]| {
-        let (c, max) = values
-            .iter()
-            .enumerate()
-            .fold((0, 0.0), |best, (c, &x)| if x > best.1 { (c, x) } else { best });
+        let (c, max) =
+            values.iter().enumerate().fold(
+                (0, 0.0),
+                |best, (c, &x)| if x > best.1 { (c, x) } else { best },
+            );
         let at = (max > 0.0).then(|| {
             let (patch, cell) = fields.locate(c);
             let grid = &fields.grids[patch];

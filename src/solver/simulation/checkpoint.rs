@@ -52,9 +52,15 @@ pub struct SavedState {
     #[serde(default, with = "nan_as_null")]
     pub element_memory: Vec<f64>,
     /// The tool-side fields of each tool (`None` for a tool without them); absent from
-    /// older checkpoints (read as empty: every tool's fields restart from zero).
-    #[serde(default)]
+    /// older checkpoints (read as empty: every tool's fields restart from zero), and not
+    /// written when no tool has fields, so that such checkpoints are what they were.
+    #[serde(default, skip_serializing_if = "no_tool_fields")]
     pub tool_fields: Vec<Option<crate::tool::surface_fields::FieldValues>>,
+}
+
+/// True when no tool has tool-side fields (the entry is then left out of the file).
+fn no_tool_fields(fields: &[Option<crate::tool::surface_fields::FieldValues>]) -> bool {
+    fields.iter().all(Option::is_none)
 }
 
 /// A vector of numbers, NaN among them, as JSON (which has no NaN): NaN as `null`.
