@@ -206,16 +206,25 @@ fn uniform_pressure_and_slip_on_a_cylinder_give_archard_in_every_covered_cell() 
     let (p, s) = (80.0, 0.35);
     let (fields, work) = uniform_load(&model, p, s);
     let f = &fields.fields;
-    // The grid's area is the cylinder's R * sweep * 4, not a projection's; the bilinear
-    // metric errs by O(cell^2 / R^2) (measured below 1e-6 here).
+    // The grid's area is the cylinder's R * sweep * 4, not a projection's (which would be
+    // 4.5 % smaller); the bilinear metric errs by O(cell^2 / R^2) = 2.3e-4 here, measured
+    // -8.7e-6.
     let area: f64 = f.cell_areas().sum();
     let exact = radius * sweep * 4.0;
-    assert!((area - exact).abs() < 1e-5 * exact, "{area} vs {exact}");
+    println!(
+        "cylinder: grid area error {:e} relative",
+        (area - exact) / exact
+    );
+    assert!(
+        (area - exact).abs() < (0.15f64 / radius).powi(2) * exact,
+        "{area} vs {exact}"
+    );
     let inside = |x: Vec3| {
         let arc = radius * x.x.atan2(x.z);
         arc >= -2.9 && arc <= 3.1 && x.y >= 0.23 && x.y <= 2.23
     };
     let covered = check_uniform(&fields, &patch, inside, p, s);
+    println!("cylinder: {covered} fully covered cells of {}", f.len());
     assert!(covered > 200, "{covered} covered cells");
     let rel = (f.total_work() - work).abs() / work;
     assert!(
