@@ -402,3 +402,54 @@ fn cup_stroke_tool_side_work_equals_the_dissipation_on_every_tool() {
     let vtu = std::fs::read_to_string(last).unwrap();
     assert!(vtu.contains("tool_wear_depth") && vtu.contains("tool_work_per_area"));
 }
+
+/// `sim.rollback(2)` after two more increments gives back the fields of the state it returns
+/// to, bit for bit (they are part of the kept states).
+#[test]
+fn rollback_restores_the_tool_side_fields() {
+    let mut sim = Simulation::new(roller_drag(12)).unwrap();
+    for _ in 0..6 {
+        sim.step().unwrap();
+    }
+    let kept = sim.tool_fields(0).unwrap().values.clone();
+    sim.step().unwrap();
+    sim.step().unwrap();
+    assert_ne!(
+        sim.tool_fields(0).unwrap().values,
+        kept,
+        "the drag goes on wearing"
+    );
+    sim.rollback(2).unwrap();
+    assert_eq!(sim.tool_fields(0).unwrap().values, kept);
+}
+
+/// Scripts: wear on an analytic plane and a hardness of 0 are refused, naming the tool or
+/// the value, with the script's line.
+#[test]
+fn script_wear_errors_name_the_fault() {
+    let dir = common::TestDir::new(&format!("tribo_tool_fields_script_{}", std::process::id()));
+    std::fs::create_dir_all(&*dir).unwrap();
+    let cases = [
+        (
+            "let mesh = block([0.0, 0.0, 0.0], [2.0, 1.0, 0.5], [4, 2, 1]);\n\
+             let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n\
+             sim.add_tool(tool(\"floor\", plane([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])).wear(archard(1e-4, 6000.0)), \"z-\");\n\
+             sim.run();\n",
+            "'floor'",
+        ),
+        ("let law = archard(1e-4, 0.0);\n", "hardness"),
+    ];
+    for (k, (script, expected)) in cases.iter().enumerate() {
+        let path = dir.join(format!("case{k}.rhai"));
+        std::fs::write(&path, script).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
+            .args(["run", "--quiet", "--out"])
+            .arg(dir.join(format!("out{k}")))
+            .arg(&path)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "case {k} ran");
+        assert!(stderr.contains(expected), "case {k}: {stderr}");
+    }
+}
