@@ -3,7 +3,8 @@
 //! - The transfer alone, on a block's contact face laid on a flat patch and wrapped on a
 //!   cylinder patch, with a uniform tool-side pressure and slip: Archard wear `c p s`,
 //!   pressure `p` and sliding distance `s` in every fully covered cell to 1e-10 relative;
-//!   the tool-side work integral equal to the nodes' dissipation to 1e-10.
+//!   the tool-side work integral equal to the nodes' dissipation to 1e-10. The same on a
+//!   general doubly curved rational Bézier patch (degree 3 x 2, unequal weights).
 //! - A real run (a roller of cylinder patches pressed and dragged over an elastic block):
 //!   after every increment the tool-side work integral equals the energy balance's frictional
 //!   dissipation to 1e-10 relative; a restart from a checkpoint continues the fields bit for
@@ -83,12 +84,13 @@ fn uniform_load(model: &Model, p: f64, s: f64) -> (ContactFields, f64) {
     (fields, work)
 }
 
-/// Checks the uniform fields in the cells whose four corners satisfy `inside`; returns
+/// Checks the uniform fields in the cells whose four corners satisfy `inside` (given their
+/// `(u, v)` and their point on the patch); returns
 /// how many cells that is. Partly covered cells get less, never more.
 fn check_uniform(
     fields: &ContactFields,
     patch: &BezierPatch,
-    inside: impl Fn(Vec3) -> bool,
+    inside: impl Fn([f64; 2], Vec3) -> bool,
     p: f64,
     s: f64,
 ) -> usize {
@@ -99,9 +101,12 @@ fn check_uniform(
     for c in 0..grid.len() {
         let (i, j) = (c / grid.nv, c % grid.nv);
         let corners = [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
-            .map(|(a, b)| patch.point(a as f64 / grid.nu as f64, b as f64 / grid.nv as f64));
+            .map(|(a, b)| [a as f64 / grid.nu as f64, b as f64 / grid.nv as f64]);
         let v = &f.values;
-        if corners.iter().all(|x| inside(*x)) {
+        if corners
+            .iter()
+            .all(|uv| inside(*uv, patch.point(uv[0], uv[1])))
+        {
             covered += 1;
             let rel = |a: f64, b: f64| (a - b).abs() / b;
             assert!(
@@ -148,7 +153,8 @@ fn uniform_pressure_and_slip_on_a_flat_tool_give_archard_in_every_covered_cell()
     // The grid's area is the patch's: 30, exact on a flat patch.
     let area: f64 = f.cell_areas().sum();
     assert!((area - 30.0).abs() < 1e-12, "{area}");
-    let inside = |x: Vec3| x.x >= x0 && x.x <= x0 + 3.0 && x.y >= y0 && x.y <= y0 + 2.0;
+    let inside =
+        |_: [f64; 2], x: Vec3| x.x >= x0 && x.x <= x0 + 3.0 && x.y >= y0 && x.y <= y0 + 2.0;
     let covered = check_uniform(&fields, &patch, inside, p, s);
     // Cells of 0.2 inside [0.13, 3.13] x [0.27, 2.27]: x from 0.2 to 3.0 (14), y from 0.4
     // to 2.2 (9).
@@ -219,7 +225,7 @@ fn uniform_pressure_and_slip_on_a_cylinder_give_archard_in_every_covered_cell() 
         (area - exact).abs() < (0.15f64 / radius).powi(2) * exact,
         "{area} vs {exact}"
     );
-    let inside = |x: Vec3| {
+    let inside = |_: [f64; 2], x: Vec3| {
         let arc = radius * x.x.atan2(x.z);
         arc >= -2.9 && arc <= 3.1 && x.y >= 0.23 && x.y <= 2.23
     };
@@ -227,6 +233,116 @@ fn uniform_pressure_and_slip_on_a_cylinder_give_archard_in_every_covered_cell() 
     println!("cylinder: {covered} fully covered cells of {}", f.len());
     assert!(covered > 200, "{covered} covered cells");
     let rel = (f.total_work() - work).abs() / work;
+    assert!(
+        rel < 1e-10,
+        "tool-side work {} vs the nodes' {work}",
+        f.total_work()
+    );
+}
+
+/// A general rational Bézier patch (degree 3 x 2, doubly curved, unequal weights) over
+/// about 6 x 5, and a block whose contact face is laid on it: the block's nodes `(x, y, z)`
+/// are put at `S(x, y) + 4 z n(x, y)`, so the contact face is the image of
+/// `[0.13, 0.83] x [0.17, 0.77]` in the patch's parameters.
+fn curved_patch() -> BezierPatch {
+    // Heights of the 4 x 3 control net: a saddle with a bump, nowhere flat.
+    let z = [
+        [0.0, 0.6, -0.2],
+        [0.8, -0.5, 0.4],
+        [-0.4, 0.9, 0.1],
+        [0.3, -0.3, 0.7],
+    ];
+    let w = [
+        [1.0, 1.4, 1.0],
+        [0.8, 1.2, 1.1],
+        [1.3, 0.7, 0.9],
+        [1.0, 1.1, 1.0],
+    ];
+    let mut points = Vec::new();
+    let mut weights = Vec::new();
+    for i in 0..4 {
+        for j in 0..3 {
+            points.push(Vec3::new(
+                -1.0 + 2.0 * i as f64,
+                -1.0 + 2.5 * j as f64,
+                2.5 * z[i][j],
+            ));
+            weights.push(w[i][j]);
+        }
+    }
+    BezierPatch::new(3, 2, points, weights).unwrap()
+}
+
+/// The same transfer on `curved_patch`: Archard's k p s / H, p, s in every cell whose
+/// parameter corners lie inside the contact face's parameter rectangle by a margin, and the
+/// tool-side work integral equal to the nodes' dissipation. Both are exact to round-off
+/// whatever the surface (the footprints tile the covered cells in (u, v), and pieces and
+/// cells are integrated with the same bilinear metric, field_grid.rs), hence 1e-10.
+#[test]
+fn uniform_pressure_and_slip_on_a_curved_bezier_patch_give_archard_in_every_covered_cell() {
+    let patch = curved_patch();
+    assert!(patch.fold().is_none());
+    let (lo, hi) = ([0.13, 0.17], [0.83, 0.77]);
+    let block = Mesh::block(
+        Vec3::new(lo[0], lo[1], 0.0),
+        Vec3::new(hi[0] - lo[0], hi[1] - lo[1], 0.05),
+        [14, 12, 1],
+    )
+    .unwrap();
+    let mut mesh = block.clone();
+    for node in &mut mesh.nodes {
+        let e = patch.evaluate(node.x, node.y);
+        let n = patch.normal(&e).unwrap();
+        // The sheet lies on the normal's side, which is +z (S_u along x, S_v along y).
+        assert!(n.z > 0.5, "{n:?}");
+        *node = e.point + 4.0 * node.z * n;
+    }
+    // Not flat and not a cylinder: the normal turns in both parameter directions (measured
+    // by 12 and 11 degrees over 0.6 of u and of v).
+    let normal = |u, v| patch.normal(&patch.evaluate(u, v)).unwrap();
+    let (n0, nu, nv) = (normal(0.2, 0.2), normal(0.8, 0.2), normal(0.2, 0.8));
+    println!(
+        "normal turns: {} along u, {} along v",
+        n0.cross(&nu).norm(),
+        n0.cross(&nv).norm()
+    );
+    assert!(n0.cross(&nu).norm() > 0.15 && n0.cross(&nv).norm() > 0.15);
+    let model = model_on(mesh, patch.clone(), 0.2);
+    let (p, s) = (80.0, 0.35);
+    let (fields, work) = uniform_load(&model, p, s);
+    let f = &fields.fields;
+    // The grid's area against a 400 x 400 midpoint sum of |S_u x S_v|: the bilinear metric
+    // errs by O(cell^2 kappa^2), measured 5.3e-4.
+    let m = 400;
+    let exact: f64 = (0..m * m)
+        .map(|c| {
+            let (u, v) = (
+                ((c / m) as f64 + 0.5) / m as f64,
+                ((c % m) as f64 + 0.5) / m as f64,
+            );
+            let e = patch.evaluate(u, v);
+            e.su.cross(&e.sv).norm() / (m * m) as f64
+        })
+        .sum();
+    let area: f64 = f.cell_areas().sum();
+    println!(
+        "curved patch: {} x {} cells, grid area {area} vs {exact} ({:e} relative)",
+        f.grids[0].nu,
+        f.grids[0].nv,
+        (area - exact) / exact
+    );
+    assert!((area - exact).abs() < 1e-3 * exact, "{area} vs {exact}");
+    // The face's outer edges run through the projections of its edges' chord midpoints,
+    // which leave the parameter rectangle's sides by O(h^2 kappa); a margin of a quarter
+    // cell keeps the checked cells inside the footprint.
+    let margin = 0.25 / f.grids[0].nu.min(f.grids[0].nv) as f64;
+    let inside =
+        |uv: [f64; 2], _: Vec3| (0..2).all(|k| uv[k] >= lo[k] + margin && uv[k] <= hi[k] - margin);
+    let covered = check_uniform(&fields, &patch, inside, p, s);
+    println!("curved patch: {covered} fully covered cells of {}", f.len());
+    assert!(covered > 150, "{covered} covered cells");
+    let rel = (f.total_work() - work).abs() / work;
+    println!("curved patch: work integral error {rel:e} relative");
     assert!(
         rel < 1e-10,
         "tool-side work {} vs the nodes' {work}",
