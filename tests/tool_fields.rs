@@ -467,7 +467,7 @@ fn fields_on_an_analytic_tool_are_refused() {
 /// with `wear = true`, 6 mm of punch travel through the command line: for every tool the
 /// tool-side work in summary.json equals the tool's frictional dissipation to 1e-8
 /// relative (by construction to round-off; summary.json's numbers round-trip exactly), and
-/// the die's frames carry the wear field.
+/// the die's frames carry the wear field; the wear and work maps are written.
 #[test]
 fn cup_stroke_tool_side_work_equals_the_dissipation_on_every_tool() {
     let out = common::TestDir::new(&format!("tribo_tool_fields_cup_{}", std::process::id()));
@@ -478,7 +478,7 @@ fn cup_stroke_tool_side_work_equals_the_dissipation_on_every_tool() {
         .arg(&*out)
         .args([
             "--set",
-            "charts=false",
+            "charts=true",
             "--set",
             "wear=true",
             "--set",
@@ -517,6 +517,31 @@ fn cup_stroke_tool_side_work_equals_the_dissipation_on_every_tool() {
     let last = frames.iter().max().unwrap();
     let vtu = std::fs::read_to_string(last).unwrap();
     assert!(vtu.contains("tool_wear_depth") && vtu.contains("tool_work_per_area"));
+    // The wear and work maps seen from above (sim.chart_tool_field): under 200 kB, and the
+    // wear map's CSV holds the largest wear depth (a block shows its cells' largest value)
+    // exactly as summary.json gives it (both print f64 round-trip).
+    for (file, tool) in [
+        ("wear_die", "die"),
+        ("work_die", "die"),
+        ("wear_punch", "punch"),
+    ] {
+        let svg = out.join(format!("{file}.svg"));
+        let bytes = std::fs::metadata(&svg).unwrap().len();
+        println!("{file}.svg: {bytes} bytes");
+        assert!(bytes < 200_000, "{file}.svg: {bytes} bytes");
+        if file.starts_with("wear") {
+            let csv = std::fs::read_to_string(out.join(format!("{file}.csv"))).unwrap();
+            let max = csv
+                .lines()
+                .skip(1)
+                .filter_map(|l| l.rsplit(',').next().unwrap().parse::<f64>().ok())
+                .fold(f64::NEG_INFINITY, f64::max);
+            let expected = summary["tools"][tool]["tool_fields"]["max_wear_depth"]
+                .as_f64()
+                .unwrap();
+            assert_eq!(max, expected, "{file}.csv");
+        }
+    }
 }
 
 /// `sim.rollback(2)` after two more increments gives back the fields of the state it returns

@@ -25,6 +25,7 @@ mod summary;
 pub mod svg;
 mod tool_fields;
 mod tool_frame;
+pub mod tool_map;
 mod vtk;
 
 pub mod run;
