@@ -594,3 +594,63 @@ fn script_wear_errors_name_the_fault() {
         assert!(stderr.contains(expected), "case {k}: {stderr}");
     }
 }
+
+/// The square cup script (scripts/square_cup.rhai, 10 x 10 cells, 15 mm of travel) with
+/// `wear = true`: the punch and die report their tool-side fields in summary.json (work equal
+/// to their frictional dissipation to 1e-8 relative, a positive wear depth), and the die's
+/// wear map at the 15 mm report travel is under 200 kB with summary.json's maximum in its CSV.
+#[test]
+fn square_cup_reports_the_die_and_punch_wear() {
+    let out = common::TestDir::new(&format!("tribo_tool_fields_square_{}", std::process::id()));
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
+        .current_dir(root)
+        .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
+        .arg(&*out)
+        .args([
+            "--set",
+            "cells=10",
+            "--set",
+            "travel=15.0",
+            "--set",
+            "wear=true",
+        ])
+        .status()
+        .expect("tribo runs");
+    assert!(status.success());
+    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for name in ["punch", "die"] {
+        let tool = &summary["tools"][name];
+        let dissipation = tool["frictional_dissipation"].as_f64().unwrap();
+        let fields = &tool["tool_fields"];
+        let work = fields["total_work"].as_f64().unwrap();
+        println!(
+            "{name}: dissipation {dissipation}, tool-side work {work}, max wear {} at {}",
+            fields["max_wear_depth"], fields["max_wear_at"]
+        );
+        assert!(
+            (work - dissipation).abs() <= 1e-8 * dissipation,
+            "{name}: {work} vs {dissipation}"
+        );
+        assert!(fields["max_wear_depth"].as_f64().unwrap() > 0.0, "{name}");
+    }
+    // Without wear the holder has no entry (runs without fields keep their summary).
+    assert!(summary["tools"]["blankholder"].get("tool_fields").is_none());
+    let svg = out.join("wear_die_15mm.svg");
+    let bytes = std::fs::metadata(&svg).unwrap().len();
+    println!("wear_die_15mm.svg: {bytes} bytes");
+    assert!(bytes < 200_000, "{bytes} bytes");
+    let csv = std::fs::read_to_string(out.join("wear_die_15mm.csv")).unwrap();
+    let max = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.rsplit(',').next().unwrap().parse::<f64>().ok())
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(
+        max,
+        summary["tools"]["die"]["tool_fields"]["max_wear_depth"]
+            .as_f64()
+            .unwrap()
+    );
+}

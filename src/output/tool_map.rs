@@ -24,8 +24,9 @@ use crate::{Error, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Blocks per map at most (about 50 bytes of SVG path each, so under 130 kB).
-pub const MAX_BLOCKS: usize = 2_500;
+/// Blocks per map at most (up to about 95 bytes of SVG path each, measured on the square
+/// cup's die, so under 150 kB).
+pub const MAX_BLOCKS: usize = 1_500;
 
 /// The field names (those of the tool's VTU frames, docs/fields.md).
 pub const FIELDS: [&str; 5] = [
