@@ -25,7 +25,9 @@ mod run_settings;
 mod shell_layers;
 mod summary;
 pub mod svg;
+mod tool_fields;
 mod tool_frame;
+pub mod tool_map;
 mod vtk;
 
 pub mod run;

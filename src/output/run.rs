@@ -341,7 +341,14 @@ impl RunOutput {
         let mut tool_files = files[1..].iter();
         let region = tool_frame::DisplayRegion::around(&sim.model.mesh.nodes);
         for (c, contact) in sim.model.contacts.iter().enumerate() {
-            if let Some(tool) = tool_frame::tool_frame(&contact.tool, &sim.tool_pose(c), &region) {
+            let pose = sim.tool_pose(c);
+            // A tool with tool-side fields is drawn on its field grid, carrying the fields.
+            let with_fields = (sim.tool_fields(c))
+                .zip(contact.tool.surface.as_patch_surface())
+                .map(|(f, surface)| super::tool_fields::frame(surface, f, &pose));
+            if let Some(tool) =
+                with_fields.or_else(|| tool_frame::tool_frame(&contact.tool, &pose, &region))
+            {
                 let (_, file) = tool_files.next().expect("one file per shown tool");
                 write_vtu(&self.folder.resolve_for_write(file)?, &tool)?;
             }
@@ -448,9 +455,7 @@ impl RunOutput {
             .enumerate()
             .map(|(c, contact)| {
                 let f = sim.tool_force(c);
-                (
-                    contact.tool.name.clone(),
-                    serde_json::json!({
+                let mut entry = serde_json::json!({
                         "final_force": [f.x, f.y, f.z],
                         "surface": contact.tool.surface.describe(),
                         "friction": contact.tool.friction.describe(),
@@ -463,8 +468,15 @@ impl RunOutput {
                             "axis": [fc.axis.x, fc.axis.y, fc.axis.z],
                             "scheduled_force": fc.force.value(sim.time()),
                         })),
-                    }),
-                )
+                    });
+                // Only a tool with fields has the entry, so that other runs' summaries (and
+                // the columns `tribo sweep collect` makes of them) are unchanged.
+                if let Some((fields, surface)) =
+                    (sim.tool_fields(c)).zip(contact.tool.surface.as_patch_surface())
+                {
+                    entry["tool_fields"] = super::tool_fields::summary(surface, fields);
+                }
+                (contact.tool.name.clone(), entry)
             })
             .collect();
         let iterations: usize = sim.history.iter().map(|r| r.iterations).sum();

@@ -1,5 +1,6 @@
 //! Charts and summary entries for scripts: `line_chart(file, spec)`,
-//! `sim.chart_field(file, face_set, field, options)` and `sim.summary(key, value)`.
+//! `sim.chart_field(file, face_set, field, options)`, `sim.chart_tool_field(file, tool,
+//! field, options)` and `sim.summary(key, value)`.
 //! Chart files go below the run's output folder (relative paths only, no `..`), each with a
 //! CSV of its data beside it.
 
@@ -105,6 +106,24 @@ fn line_chart_spec(spec: &Map) -> ScriptResult<LineChart> {
     Ok(chart)
 }
 
+/// The map of tool `tool`'s tool-side field `field` at the committed state: an error
+/// naming the tool when it has no tool-side fields (no `tool.wear(...)`).
+fn tool_map(
+    sim: &crate::solver::Simulation,
+    tool: &str,
+    field: &str,
+) -> crate::Result<crate::output::tool_map::ToolMap> {
+    let c = sim.model.tool_index(tool)?;
+    let surface = sim.model.contacts[c].tool.surface.as_patch_surface();
+    let (Some(fields), Some(surface)) = (sim.tool_fields(c), surface) else {
+        return Err(crate::Error::Input(format!(
+            "tool '{tool}' has no tool-side fields (give it tool.wear(archard(k, H)))"
+        )));
+    };
+    let pose = sim.tool_pose(c);
+    crate::output::tool_map::ToolMap::new(tool, surface, fields, &pose, field, sim.time())
+}
+
 /// The colour range of a field map: the drawn values', a fixed one, or the friction law's.
 enum Range {
     Data,
@@ -190,6 +209,72 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                     s.clone(),
                     file.to_string(),
                     face_set.to_string(),
+                    field.to_string(),
+                    Map::new(),
+                ),
+            )
+        },
+    );
+    let h = host.clone();
+    engine.register_fn(
+        "chart_tool_field",
+        move |s: &mut ScriptSim,
+              file: &str,
+              tool: &str,
+              field: &str,
+              options: Map|
+              -> ScriptResult<()> {
+            let path = chart_path(&h, file)?;
+            let mut st = s.borrow_mut();
+            let unit = st.length_unit();
+            let sim = st.simulation()?;
+            let mut m = lift(tool_map(sim, tool, field))?;
+            let axis = |name: &str| {
+                if unit.is_empty() {
+                    name.to_string()
+                } else {
+                    format!("{name} [{unit}]")
+                }
+            };
+            (m.map.x_label, m.map.y_label) = (axis("x"), axis("y"));
+            for (key, v) in &options {
+                match key.as_str() {
+                    "title" => m.map.title = string(v, "chart title")?,
+                    "label" => m.map.label = string(v, "colour bar label")?,
+                    "range" => {
+                        let r = numbers(v, "range")?;
+                        if r.len() != 2 {
+                            return runtime_error(format!(
+                                "range must be [low, high], got {} numbers",
+                                r.len()
+                            ));
+                        }
+                        m.map.range = Some((r[0], r[1]));
+                    }
+                    other => {
+                        return runtime_error(format!(
+                            "unknown chart_tool_field option '{other}' (known: title, label, range)"
+                        ))
+                    }
+                }
+            }
+            lift(m.write(&path).map(|_| ()))
+        },
+    );
+    engine.register_fn(
+        "chart_tool_field",
+        |ctx: rhai::NativeCallContext,
+         s: &mut ScriptSim,
+         file: &str,
+         tool: &str,
+         field: &str|
+         -> ScriptResult<()> {
+            ctx.call_native_fn(
+                "chart_tool_field",
+                (
+                    s.clone(),
+                    file.to_string(),
+                    tool.to_string(),
                     field.to_string(),
                     Map::new(),
                 ),

@@ -531,6 +531,7 @@ fn register_tools(engine: &mut Engine) {
         t.friction = law;
         t.clone()
     });
+    register_wear(engine);
     engine.register_get("name", |t: &mut Tool| t.name.clone());
     engine.register_fn("to_string", |t: &mut Tool| {
         format!(
@@ -540,6 +541,56 @@ fn register_tools(engine: &mut Engine) {
             t.friction.describe()
         )
     });
+}
+
+/// Archard wear laws and `tool.wear(law[, cell])`, which switches a tool's tool-side fields
+/// on (src/tool/surface_fields.rs).
+fn register_wear(engine: &mut Engine) {
+    use crate::tool::{FieldSpec, WearLaw};
+    engine.register_type_with_name::<WearLaw>("WearLaw");
+    engine.register_fn(
+        "archard",
+        |k: Dynamic, h: Dynamic| -> ScriptResult<WearLaw> {
+            lift(WearLaw::archard(
+                number(&k, "Archard wear coefficient k")?,
+                number(&h, "Archard hardness H")?,
+            ))
+        },
+    );
+    engine.register_fn(
+        "archard_coefficient",
+        |c: Dynamic| -> ScriptResult<WearLaw> {
+            lift(WearLaw::dimensional(number(
+                &c,
+                "dimensional wear coefficient",
+            )?))
+        },
+    );
+    engine.register_fn("to_string", |w: &mut WearLaw| {
+        format!("Archard wear, dh = {} p |ds|", w.coefficient)
+    });
+    engine.register_fn("wear", |t: &mut Tool, law: WearLaw| -> Tool {
+        t.fields = Some(FieldSpec {
+            wear: law,
+            cell: None,
+        });
+        t.clone()
+    });
+    engine.register_fn(
+        "wear",
+        |t: &mut Tool, law: WearLaw, cell: Dynamic| -> ScriptResult<Tool> {
+            let what = format!("cell size of the tool-side fields of tool '{}'", t.name);
+            let cell = number(&cell, &what)?;
+            if !(cell > 0.0 && cell.is_finite()) {
+                return lift(Err(crate::Error::input(&what, cell, "must be > 0")));
+            }
+            t.fields = Some(FieldSpec {
+                wear: law,
+                cell: Some(cell),
+            });
+            Ok(t.clone())
+        },
+    );
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! Rigid tools: a surface, its pose, and how the pose moves with pseudo-time (see docs/architecture.md).
 
+pub mod field_grid;
 pub mod force_control;
 pub mod pose;
 pub mod schedule;
@@ -7,6 +8,8 @@ pub mod schedule;
 pub use pose::{project_posed, Pose};
 pub use schedule::{ScalarSchedule, Schedule};
 pub mod rigid_tool;
+pub mod surface_fields;
 
 pub use force_control::ForceControl;
 pub use rigid_tool::Tool;
+pub use surface_fields::{FieldSpec, ToolFields, WearLaw};

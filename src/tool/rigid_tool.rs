@@ -3,6 +3,7 @@
 use super::force_control::ForceControl;
 use super::pose::{project_posed, Pose};
 use super::schedule::Schedule;
+use super::surface_fields::FieldSpec;
 use crate::contact::FrictionLaw;
 use crate::geometry::{Projection, RigidSurface, SurfaceHint, Vec3};
 use std::sync::Arc;
@@ -16,6 +17,9 @@ pub struct Tool {
     pub friction: FrictionLaw,
     /// When set, the tool's position along an axis is an unknown fixed by a force schedule.
     pub force_control: Option<ForceControl>,
+    /// When set, the tool accumulates tool-side fields (work, pressure, Archard wear) on
+    /// its patches (`surface_fields.rs`).
+    pub fields: Option<FieldSpec>,
 }
 
 impl Tool {
@@ -26,6 +30,7 @@ impl Tool {
             schedule: Schedule::fixed(),
             friction: FrictionLaw::frictionless(),
             force_control: None,
+            fields: None,
         }
     }
 

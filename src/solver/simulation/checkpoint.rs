@@ -56,6 +56,16 @@ pub struct SavedState {
     /// older checkpoints (none).
     #[serde(default)]
     pub step_ends: Vec<(usize, f64)>,
+    /// The tool-side fields of each tool (`None` for a tool without them); absent from
+    /// older checkpoints (read as empty: every tool's fields restart from zero), and not
+    /// written when no tool has fields, so that such checkpoints are what they were.
+    #[serde(default, skip_serializing_if = "no_tool_fields")]
+    pub tool_fields: Vec<Option<crate::tool::surface_fields::FieldValues>>,
+}
+
+/// True when no tool has tool-side fields (the entry is then left out of the file).
+fn no_tool_fields(fields: &[Option<crate::tool::surface_fields::FieldValues>]) -> bool {
+    fields.iter().all(Option::is_none)
 }
 
 /// A vector of numbers, NaN among them, as JSON (which has no NaN): NaN as `null`.
@@ -263,6 +273,7 @@ impl Checkpoint {
         // The schedules of steps ended early, before the tools' poses are compared.
         sim.check_step_ends(&s.step_ends)?;
         sim.set_step_ends(s.step_ends.clone());
+        check_tool_fields(sim, &s.tool_fields)?;
         for (c, (contact, stored)) in sim.model.contacts.iter().zip(&self.tool_poses).enumerate() {
             let here = pose_points(&contact.tool.pose(s.time));
             let d = here
@@ -290,6 +301,52 @@ impl Checkpoint {
         sim.clear_rollback();
         Ok(())
     }
+}
+
+/// The checkpoint's tool-side fields against the model's: the same tools have them, on
+/// grids of the same size, with finite values >= 0. An older checkpoint without them (empty)
+/// passes: the fields restart from zero.
+fn check_tool_fields(
+    sim: &Simulation,
+    saved: &[Option<crate::tool::surface_fields::FieldValues>],
+) -> Result<()> {
+    if saved.is_empty() {
+        return Ok(());
+    }
+    let n_tools = sim.model.contacts.len();
+    if saved.len() != n_tools {
+        return Err(Error::Input(format!(
+            "the checkpoint's state.tool_fields has {} entries for {n_tools} tools (the file was edited or is damaged)",
+            saved.len()
+        )));
+    }
+    for (c, values) in saved.iter().enumerate() {
+        let name = &sim.model.contacts[c].tool.name;
+        match (sim.tool_fields(c), values) {
+            (None, None) => {}
+            (Some(fields), Some(values)) => {
+                let mut check = fields.clone();
+                check.set_values(name, values.clone())?;
+                let all = [&values.work, &values.slip, &values.peak_pressure, &values.pressure_time, &values.wear];
+                if let Some(v) = all.iter().flat_map(|f| f.iter()).find(|v| !(**v >= 0.0 && v.is_finite())) {
+                    return Err(Error::Input(format!(
+                        "the checkpoint's state.tool_fields[{c}] (tool '{name}') holds {v}, but its values are finite and >= 0 (the file was edited or is damaged)"
+                    )));
+                }
+            }
+            (Some(_), None) => {
+                return Err(Error::Input(format!(
+                    "tool '{name}' accumulates tool-side fields (tool.wear) but the checkpoint has none for it: it was written without them"
+                )))
+            }
+            (None, Some(_)) => {
+                return Err(Error::Input(format!(
+                    "the checkpoint has tool-side fields for tool '{name}', which the script does not ask for (tool.wear)"
+                )))
+            }
+        }
+    }
+    Ok(())
 }
 
 impl Checkpoint {

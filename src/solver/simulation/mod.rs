@@ -9,6 +9,7 @@ pub mod kinematics_check;
 pub mod step_control;
 pub mod step_end;
 pub mod stepping;
+pub mod tool_fields;
 
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
 use crate::geometry::Vec3;
@@ -147,6 +148,9 @@ pub struct Simulation {
     /// Steps ended by their condition: (step, time of the increment that met it), in
     /// order. Part of the committed state.
     pub(super) step_ends: Vec<(usize, f64)>,
+    /// Tool-side fields of each tool that asks for them (`Tool::fields`), accumulated in
+    /// `commit`.
+    pub(super) tool_fields: Vec<Option<tool_fields::ContactFields>>,
 }
 
 impl Simulation {
@@ -219,6 +223,11 @@ impl Simulation {
                     .collect()
             })
             .collect();
+        let tool_fields = model
+            .contacts
+            .iter()
+            .map(|c| tool_fields::ContactFields::new(c, &model.mesh))
+            .collect::<Result<Vec<_>>>()?;
         let dofs_nodes = dofs.n_nodes;
         let initial_f_ext = model.external_forces(0.0);
         let condenser = if model.settings.eliminate_multipliers {
@@ -260,6 +269,7 @@ impl Simulation {
                 .map(|c| c.tool.schedule.clone())
                 .collect(),
             step_ends: Vec::new(),
+            tool_fields,
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
@@ -529,6 +539,8 @@ impl Simulation {
         for (c, contact) in self.model.contacts.iter().enumerate() {
             let pose = force_control::pose(&self.model, &self.dofs, c, t_new, &x);
             let mut total = Vec3::zeros();
+            let with_fields = self.tool_fields[c].is_some();
+            let mut loads = Vec::new();
             for (k, &node) in contact.candidates.iter().enumerate() {
                 let (res, proj) = &eval.nodal[c][k];
                 let s = &mut self.contact[c][k];
@@ -589,8 +601,32 @@ impl Simulation {
                     .bernstein()
                     .map_or(0.0, |law| law.theta(s.work, area));
                 total += s.lambda;
+                if with_fields {
+                    loads.push(crate::tool::surface_fields::NodeLoad {
+                        work: friction,
+                        normal_force: if res.status.is_active() {
+                            (-s.lambda.dot(&s.normal)).max(0.0)
+                        } else {
+                            0.0
+                        },
+                        slip: s.slip_increment.norm(),
+                    });
+                }
             }
             tool_forces.push([total.x, total.y, total.z]);
+            if let Some(fields) = self.tool_fields[c].as_mut() {
+                let position = |n: usize| {
+                    self.model.mesh.nodes[n] + Vec3::new(x[3 * n], x[3 * n + 1], x[3 * n + 2])
+                };
+                fields.accumulate(
+                    contact,
+                    &pose,
+                    position,
+                    &self.contact[c],
+                    &loads,
+                    t_new - self.time,
+                );
+            }
         }
         let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated, &normal_work);
         let tool_offsets = (0..self.model.contacts.len())
@@ -649,6 +685,11 @@ impl Simulation {
             last_step: self.last_step.clone(),
             element_memory: self.committed_memory.clone(),
             step_ends: self.step_ends.clone(),
+            tool_fields: self
+                .tool_fields
+                .iter()
+                .map(|f| f.as_ref().map(|f| f.fields.values.clone()))
+                .collect(),
         }
     }
 
@@ -668,6 +709,17 @@ impl Simulation {
         self.committed_memory = state.element_memory;
         self.committed_forces = None;
         self.set_step_ends(state.step_ends);
+        // Shapes were checked by `Checkpoint::restore` (or come from this simulation).
+        for (fields, values) in self.tool_fields.iter_mut().zip(state.tool_fields) {
+            if let (Some(f), Some(v)) = (fields.as_mut(), values) {
+                f.fields.values = v;
+            }
+        }
+    }
+
+    /// The tool-side fields of tool `c`, if it accumulates them (`Tool::fields`).
+    pub fn tool_fields(&self, c: usize) -> Option<&crate::tool::ToolFields> {
+        self.tool_fields[c].as_ref().map(|f| &f.fields)
     }
 
     /// Replaces the settings of a running simulation (after a rollback in the REPL, say).
