@@ -76,13 +76,17 @@ fn a_second_run_into_a_busy_folder_is_refused() {
         assert!(a == b, "{file} differs from the lone run's");
     }
 
-    // kill -9 leaves the lock file; the next run takes it over with a warning.
+    // kill -9 leaves the lock file; the next run takes it over with a warning (and, the
+    // killed run's results being in the folder, needs --overwrite to run there).
     let mut victim = tribo(&base.join("killed")).spawn().unwrap();
     wait_for(&base.join("killed/.tribo.lock"));
     victim.kill().unwrap();
     victim.wait().unwrap();
     assert!(base.join("killed/.tribo.lock").exists());
-    let next = tribo(&base.join("killed")).output().unwrap();
+    let next = tribo(&base.join("killed"))
+        .arg("--overwrite")
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&next.stderr);
     assert!(next.status.success(), "{err}");
     assert!(

@@ -96,7 +96,7 @@ let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
 let roller = tool("roller", cylinder([0, 0, 2], [0, 1, 0], 1.0)).path([[0, 0, 0, 0], [1, 0, 0, -1.1]]);
 sim.add_tool(roller, "z+");
 sim.fix("z-", "xyz");
-sim.settings(#{ increments: 2 });
+sim.settings(#{ increments: 2, kinematics: "small" });
 sim.run();
 "#;
 

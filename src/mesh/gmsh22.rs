@@ -270,15 +270,23 @@ impl Reader {
                 let Some((nodes, _)) = nodes_of_type(ty) else {
                     return Err(self.unsupported(c, at, None, ty));
                 };
-                let room = (c.bytes.len() - c.pos) / 4;
-                if count <= 0
-                    || ntags < 0
-                    || done + count as usize > n
-                    || 1 + ntags as usize + nodes > room
-                {
+                if count <= 0 || ntags < 0 || done + count as usize > n {
                     return Err(c.error(
                         at,
                         &format!("element block header `{ty} {count} {ntags}` is not valid"),
+                    ));
+                }
+                // A valid header whose block the file cannot hold: cut short (checked before
+                // reading, so that a huge count allocates nothing).
+                let room = (c.bytes.len() - c.pos) / 4;
+                let need = (count as usize).saturating_mul(1 + ntags as usize + nodes);
+                if need > room {
+                    return Err(c.error(
+                        at,
+                        &format!(
+                            "the file ends inside element block `{ty} {count} {ntags}` \
+                             ({need} values, {room} left)"
+                        ),
                     ));
                 }
                 for _ in 0..count {
