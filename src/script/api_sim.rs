@@ -116,9 +116,8 @@ fn advance(ctx: &NativeCallContext, s: &ScriptSim) -> ScriptResult<IncrementRepo
     Ok(report)
 }
 
-/// How the solver's warning about small-strain kinematics past their range begins
-/// (`kinematics_check::small_strain_warning`).
-const SMALL_STRAIN_WARNING: &str = "small-strain kinematics";
+/// How the solver's warning about small-strain kinematics past their range begins.
+use crate::solver::simulation::kinematics_check::SMALL_STRAIN_WARNING_START as SMALL_STRAIN_WARNING;
 
 impl SimState {
     /// A run on the default kinematics ("small": the script never chose) whose largest

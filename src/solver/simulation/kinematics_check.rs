@@ -39,6 +39,11 @@ fn infinitesimal_rotation(f: &Mat3) -> f64 {
     0.5 * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt()
 }
 
+/// How [`small_strain_warning`] begins: the script layer, which turns the warning into an
+/// error where the script never chose its kinematics, recognises it by this constant (the
+/// warning and the constant live together, so they cannot drift apart).
+pub const SMALL_STRAIN_WARNING_START: &str = "small-strain kinematics";
+
 /// The warning, when the largest rotation crosses the limit between the committed points
 /// `before` and the newly converged `after` (so it is given once per run, and again only
 /// if a run unloads below the limit and rotates past it once more).
@@ -54,7 +59,7 @@ pub fn small_strain_warning(
     }
     let element = point / points_per_element.max(1);
     Some(format!(
-        "small-strain kinematics (the engine's default) with a rotation of {new:.3} rad at element {element}: the small-strain strain sym(grad u) reads a rotation by θ as a \
+        "{SMALL_STRAIN_WARNING_START} (the engine's default) with a rotation of {new:.3} rad at element {element}: the small-strain strain sym(grad u) reads a rotation by θ as a \
          stretch of about θ²/2 = {:.1e}, so stresses and plastic flow from here on carry that \
          error. A sheet that bends over tools, or any large deflection, needs \
          sim.settings(#{{ kinematics: \"finite\" }}).",
