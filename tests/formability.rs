@@ -372,6 +372,9 @@ sim.run();
     let unknown = run("furlong", 1.0, "furlong");
     assert_eq!(unknown["kind"], "none", "{unknown}");
     let reason = unknown["reason"].as_str().unwrap();
-    assert!(reason.contains("'furlong'") && reason.contains("flc"), "{reason}");
+    assert!(
+        reason.contains("'furlong'") && reason.contains("flc"),
+        "{reason}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -30,7 +30,14 @@ fn run(tag: &str, extra: &[&str]) -> Value {
     cmd.current_dir(root)
         .args(["run", "scripts/square_cup.rhai", "--quiet", "--out"])
         .arg(&out)
-        .args(["--set", "cells=10", "--set", "travel=10.0", "--set", "charts=false"]);
+        .args([
+            "--set",
+            "cells=10",
+            "--set",
+            "travel=10.0",
+            "--set",
+            "charts=false",
+        ]);
     for s in extra {
         cmd.args(["--set", s]);
     }
@@ -89,7 +96,10 @@ fn four_sheet_models_of_one_coarse_cup() {
     assert!(relative(margin(fs), margin(fg)) < 1e-9, "{fs}\n{fg}");
     for key in ["max_thinning_at", "min_flc_margin_at"] {
         let (a, b) = (place(fs, key), place(fg, key));
-        assert!((a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9, "{key}: {a:?} {b:?}");
+        assert!(
+            (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9,
+            "{key}: {a:?} {b:?}"
+        );
     }
     assert_eq!(fs["nodes_per_zone"], fg["nodes_per_zone"]);
     assert_eq!(fs["flc"], fg["flc"]);
@@ -101,7 +111,10 @@ fn four_sheet_models_of_one_coarse_cup() {
         ("max thinning", thinning(f1), thinning(f4)),
         ("min FLC margin", margin(f1), margin(f4)),
     ] {
-        assert!(relative(a, b) < 0.025, "{what}: {a} (1 layer) vs {b} (4 layers)");
+        assert!(
+            relative(a, b) < 0.025,
+            "{what}: {a} (1 layer) vs {b} (4 layers)"
+        );
     }
     for key in ["max_thinning_at", "min_flc_margin_at"] {
         assert_eq!(place(f1, key), place(f4, key), "{key}");

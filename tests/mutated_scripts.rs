@@ -179,6 +179,9 @@ fn cpu_time_counts_work_not_waiting() {
     let worked = mutate::cpu_time(me).unwrap();
     // Other test threads may run meanwhile; the busy loop alone adds well over 0.1 s even
     // at a quarter of a core, and sleeping adds at most their share.
-    assert!(worked - slept >= std::time::Duration::from_millis(60), "{before:?} {slept:?} {worked:?}");
+    assert!(
+        worked - slept >= std::time::Duration::from_millis(60),
+        "{before:?} {slept:?} {worked:?}"
+    );
     assert!(worked >= slept && slept >= before);
 }

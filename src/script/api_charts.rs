@@ -308,7 +308,11 @@ pub fn register(engine: &mut Engine, host: Rc<HostOptions>) {
                      forming limit diagram",
                 );
             };
-            let unit = if time_unit.is_empty() { String::new() } else { format!(" {time_unit}") };
+            let unit = if time_unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {time_unit}")
+            };
             let chart = crate::output::fld_chart::FldChart {
                 title: title.unwrap_or_else(|| {
                     format!(

@@ -72,7 +72,8 @@ pub fn curve(sim: &Simulation, options: &FormabilityOptions) -> std::result::Res
         return Ok(flc.clone());
     }
     let n = (sim.model.material.hardening_exponent()).ok_or_else(|| {
-        "no curve: the material has no Swift law for Keeler-Brazier; give the setting flc".to_string()
+        "no curve: the material has no Swift law for Keeler-Brazier; give the setting flc"
+            .to_string()
     })?;
     let mm = Flc::millimetres_per(&options.length_unit).ok_or_else(|| {
         format!(
