@@ -13,7 +13,7 @@
 //! own frame (the surface's coordinates, which do not move with the stroke).
 
 use super::{Field, Frame};
-use crate::geometry::{PatchSurface, Vec3};
+use crate::geometry::PatchSurface;
 use crate::tool::{Pose, ToolFields};
 
 /// The VTU frame of `fields` on `surface`'s patches at `pose` (module doc).
@@ -21,27 +21,7 @@ pub fn frame(surface: &PatchSurface, fields: &ToolFields, pose: &Pose) -> Frame 
     let mut frame = Frame::default();
     let mut normals: Vec<[f64; 3]> = Vec::new();
     for (patch, grid) in surface.patches().iter().zip(&fields.grids) {
-        let first = frame.points.len();
-        let (nu, nv) = (grid.nu, grid.nv);
-        for i in 0..=nu {
-            for j in 0..=nv {
-                let e = patch.evaluate(i as f64 / nu as f64, j as f64 / nv as f64);
-                let x = pose.to_global_point(&e.point);
-                let n = patch
-                    .normal(&e)
-                    .map_or(Vec3::zeros(), |n| pose.to_global_vector(&n));
-                frame.points.push([x.x, x.y, x.z]);
-                normals.push([n.x, n.y, n.z]);
-            }
-        }
-        let id = |i: usize, j: usize| first + i * (nv + 1) + j;
-        for i in 0..nu {
-            for j in 0..nv {
-                frame
-                    .quads
-                    .push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
+        super::tool_frame::add_patch_grid(&mut frame, &mut normals, patch, pose, grid.nu, grid.nv);
     }
     frame.point_data.push(Field::vector("normal", &normals));
     let v = &fields.values;

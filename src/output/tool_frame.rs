@@ -133,7 +133,20 @@ fn samples(degree: usize) -> usize {
 
 fn add_patch(frame: &mut Frame, normals: &mut Vec<[f64; 3]>, patch: &BezierPatch, pose: &Pose) {
     let (p, q) = patch.degrees();
-    let (su, sv) = (samples(p), samples(q));
+    add_patch_grid(frame, normals, patch, pose, samples(p), samples(q));
+}
+
+/// Appends `patch` at `pose` sampled at the `(su + 1) x (sv + 1)` parameter nodes
+/// `(i / su, j / sv)`: the points, their unit normals (zero where the normal is undefined)
+/// and the `su x sv` quadrilaterals between them, cell `(i, j)` the `i * sv + j`-th.
+pub(super) fn add_patch_grid(
+    frame: &mut Frame,
+    normals: &mut Vec<[f64; 3]>,
+    patch: &BezierPatch,
+    pose: &Pose,
+    su: usize,
+    sv: usize,
+) {
     let first = frame.points.len();
     for i in 0..=su {
         for j in 0..=sv {
