@@ -73,6 +73,7 @@ pub fn summary(surface: &PatchSurface, fields: &ToolFields) -> serde_json::Value
 mod tests {
     use super::*;
     use crate::geometry::BezierPatch;
+    use crate::geometry::Vec3;
     use crate::tool::WearLaw;
 
     /// A 2 x 1 flat patch with cells of 0.5: 4 x 2 quads at the pose, one value per cell
