@@ -196,6 +196,14 @@ pub enum FrictionLaw {
     /// Set from outside after each converged increment (a script function: the script layer
     /// calls it, so that nothing below it knows Rhai). `initial` is mu of a virgin node.
     External { initial: f64 },
+    /// mu as a Bernstein polynomial of the TOOL's accumulated frictional work per area at
+    /// the node's foot: theta = min(w_tool / work_cut, 1) (issue 53: a coating wearing over
+    /// the strokes raises mu). The law's work is the tool's work per area (force/length),
+    /// whatever its `measure`. The tool's state is held by the simulation, not by a node,
+    /// so the simulation sets mu (`mu` returns `None`), from the tool state frozen at the
+    /// start of the stroke; mu is therefore constant within an increment and has no
+    /// derivative in the Jacobian (module `solver::simulation::strokes`).
+    ToolWork(BernsteinLaw),
 }
 
 impl std::fmt::Debug for FrictionLaw {
@@ -223,7 +231,7 @@ impl FrictionLaw {
             FrictionLaw::Coulomb { mu } => Some(*mu),
             FrictionLaw::Bernstein(law) => Some(law.mu(input.work, input.area)),
             FrictionLaw::Function(f) => Some(f(input)),
-            FrictionLaw::External { .. } => None,
+            FrictionLaw::External { .. } | FrictionLaw::ToolWork(_) => None,
         }
     }
 
@@ -231,6 +239,7 @@ impl FrictionLaw {
     pub fn initial_mu(&self, area: f64) -> f64 {
         match self {
             FrictionLaw::External { initial } => *initial,
+            FrictionLaw::ToolWork(law) => law.mu_of_theta(0.0),
             other => other
                 .mu(&FrictionInput {
                     area,
@@ -263,6 +272,12 @@ impl FrictionLaw {
             FrictionLaw::External { initial } => {
                 format!("script function (mu at zero work = {initial})")
             }
+            FrictionLaw::ToolWork(l) => format!(
+                "Bernstein of the tool's work per area, degree {} control points {:?}, work_cut = {}",
+                l.degree(),
+                l.control_points,
+                l.work_cut
+            ),
         }
     }
 }

@@ -150,6 +150,11 @@ impl RunOutput {
             // `steps`) each increment belongs to. Single-step runs keep their columns.
             columns.insert(1, ("step".to_string(), None));
         }
+        if sim.model.strokes.total > 1 {
+            // A production run of strokes: the stroke of each increment, from 1 (time
+            // restarts at 0 in every stroke). Runs of one stroke keep their columns.
+            columns.insert(1, ("stroke".to_string(), None));
+        }
         for c in &sim.model.contacts {
             for axis in ["x", "y", "z"] {
                 columns.push((format!("{}_force_{axis}", c.tool.name), Force));
@@ -282,6 +287,9 @@ impl RunOutput {
         ];
         if let Some(k) = r.step {
             row.insert(1, k as f64);
+        }
+        if sim.model.strokes.total > 1 {
+            row.insert(1, r.stroke as f64);
         }
         for f in &r.tool_forces {
             row.extend_from_slice(f);
@@ -553,6 +561,20 @@ impl RunOutput {
         if let Some(map) = summary.as_object_mut() {
             if !sim.model.steps.is_empty() {
                 map.insert("steps".into(), steps_summary(sim, &self.frame_times));
+            }
+            let strokes = sim.model.strokes;
+            if strokes.total > 1 {
+                // The tools' `tool_fields` are totals over all strokes (extrapolated to
+                // `total` when fewer were simulated); everything else is the last stroke's.
+                map.insert(
+                    "strokes".into(),
+                    serde_json::json!({
+                        "total": strokes.total,
+                        "simulated": strokes.simulated,
+                        "extrapolated": strokes.extrapolated(),
+                        "current": sim.stroke(),
+                    }),
+                );
             }
             for (key, value) in &self.extra {
                 if map.contains_key(key) {

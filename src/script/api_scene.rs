@@ -591,6 +591,22 @@ fn register_wear(engine: &mut Engine) {
             Ok(t.clone())
         },
     );
+    // tool.friction_of_tool_work(bernstein([...], w_cut)): mu of the tool's frictional work
+    // per area at each node's foot, frozen at the stroke's start (solver::simulation::strokes).
+    engine.register_fn(
+        "friction_of_tool_work",
+        |t: &mut Tool, law: FrictionLaw| -> ScriptResult<Tool> {
+            let FrictionLaw::Bernstein(l) = law else {
+                return runtime_error(format!(
+                    "tool '{}': friction_of_tool_work needs a Bernstein law (bernstein([P0, ..., Pm], w_cut), w_cut the tool's work per area at which mu reaches Pm), not {}",
+                    t.name,
+                    law.describe()
+                ));
+            };
+            t.friction = FrictionLaw::ToolWork(l);
+            Ok(t.clone())
+        },
+    );
 }
 
 #[cfg(test)]

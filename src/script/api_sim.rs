@@ -561,7 +561,9 @@ impl SimState {
         }
         if let Some(out) = self.output.as_mut() {
             lift(out.record(sim))?;
-            if frames_on {
+            // A production run of strokes writes the frames of its last simulated stroke
+            // (beside the t = 0 frame of the blank, the same in every stroke).
+            if frames_on && sim.is_last_stroke() {
                 lift(out.write_frame_if_due(sim, report.index))?;
                 // A process in steps: a frame at every step's end (the formed, the
                 // clamped and the released shapes).
@@ -617,6 +619,7 @@ fn report_map(r: &IncrementReport, tools: &[String]) -> Map {
         "step".into(),
         r.step.map_or(Dynamic::UNIT, |k| Dynamic::from(k as i64)),
     );
+    m.insert("stroke".into(), Dynamic::from(r.stroke as i64));
     m.insert("time".into(), Dynamic::from(r.time));
     m.insert("iterations".into(), Dynamic::from(r.iterations as i64));
     m.insert("cutbacks".into(), Dynamic::from(r.cutbacks as i64));
@@ -952,6 +955,7 @@ fn run(ctx: &NativeCallContext, s: &mut ScriptSim, host: &HostOptions) -> Script
     let mut st = s.borrow_mut();
     st.simulation()?;
     let end_time = st.sim.as_ref().expect("started").model.settings.end_time;
+    let simulated = st.sim.as_ref().expect("started").model.strokes.simulated;
     let bar = host.progress.then(progress_bar);
     st.progress = bar.clone();
     let mut last = None;
@@ -968,7 +972,9 @@ fn run(ctx: &NativeCallContext, s: &mut ScriptSim, host: &HostOptions) -> Script
             }
         };
         if let Some(b) = &bar {
-            b.set_position((1000.0 * r.time / end_time).round() as u64);
+            // Over all simulated strokes (time restarts in each).
+            let done = ((r.stroke - 1) as f64 + r.time / end_time) / simulated as f64;
+            b.set_position((1000.0 * done).round() as u64);
             b.set_message(format!(
                 "increment {}, t = {:.4}, dt = {:.3e}, {} Newton iterations",
                 r.index, r.time, r.dt, r.iterations

@@ -15,6 +15,7 @@ mod api_scene;
 mod api_shell;
 mod api_sim;
 mod api_steps;
+mod api_strokes;
 mod api_tools;
 mod convert;
 pub mod limits;
@@ -167,6 +168,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     api_tools::register(&mut engine, policy);
     api_sim::register(&mut engine, host.clone());
     api_steps::register(&mut engine);
+    api_strokes::register(&mut engine);
     api_charts::register(&mut engine, host);
     api_mesh_map::register(&mut engine);
     api_shell::register(&mut engine);

@@ -5,6 +5,7 @@ pub mod augmentation;
 pub mod follower_load;
 pub mod rigid_modes;
 pub mod steps;
+pub mod strokes;
 
 use crate::geometry::Vec3;
 use crate::material::Material;
@@ -66,6 +67,8 @@ pub struct Model {
     pub settings: SolverSettings,
     /// The process's named steps (`steps`); empty: one step over the whole run.
     pub steps: Vec<steps::Step>,
+    /// A production run of several strokes (`strokes`); the default is one.
+    pub strokes: strokes::Strokes,
 }
 
 impl Model {
@@ -80,6 +83,7 @@ impl Model {
             contacts: Vec::new(),
             settings: SolverSettings::default(),
             steps: Vec::new(),
+            strokes: strokes::Strokes::default(),
         })
     }
 

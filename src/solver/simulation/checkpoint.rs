@@ -61,6 +61,22 @@ pub struct SavedState {
     /// written when no tool has fields, so that such checkpoints are what they were.
     #[serde(default, skip_serializing_if = "no_tool_fields")]
     pub tool_fields: Vec<Option<crate::tool::surface_fields::FieldValues>>,
+    /// The stroke of a production run, from 0 (`model::strokes`); absent from older
+    /// checkpoints and from runs of one stroke (0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub stroke: usize,
+    /// Per tool whose friction reads the tool's work: that work frozen at the stroke's
+    /// start (module `simulation::strokes`); left out when no tool's friction reads it.
+    #[serde(default, skip_serializing_if = "no_frozen_work")]
+    pub tool_work_frozen: Vec<Option<Vec<f64>>>,
+}
+
+fn is_zero(k: &usize) -> bool {
+    *k == 0
+}
+
+fn no_frozen_work(frozen: &[Option<Vec<f64>>]) -> bool {
+    frozen.iter().all(Option::is_none)
 }
 
 /// True when no tool has tool-side fields (the entry is then left out of the file).
@@ -274,6 +290,7 @@ impl Checkpoint {
         sim.check_step_ends(&s.step_ends)?;
         sim.set_step_ends(s.step_ends.clone());
         check_tool_fields(sim, &s.tool_fields)?;
+        check_strokes(sim, s)?;
         for (c, (contact, stored)) in sim.model.contacts.iter().zip(&self.tool_poses).enumerate() {
             let here = pose_points(&contact.tool.pose(s.time));
             let d = here
@@ -344,6 +361,49 @@ fn check_tool_fields(
                     "the checkpoint has tool-side fields for tool '{name}', which the script does not ask for (tool.wear)"
                 )))
             }
+        }
+    }
+    Ok(())
+}
+
+/// The checkpoint's stroke within the script's strokes, and the frozen work of every tool
+/// whose friction reads it: present, one finite value >= 0 per cell.
+fn check_strokes(sim: &Simulation, s: &SavedState) -> Result<()> {
+    let simulated = sim.model.strokes.simulated;
+    if s.stroke >= simulated {
+        return Err(Error::Input(format!(
+            "the checkpoint is in stroke {} but the script simulates {simulated} stroke(s) (sim.strokes)",
+            s.stroke + 1
+        )));
+    }
+    for (c, contact) in sim.model.contacts.iter().enumerate() {
+        let Some(fields) = sim.tool_fields(c) else {
+            continue;
+        };
+        if !matches!(
+            contact.tool.friction,
+            crate::contact::FrictionLaw::ToolWork(_)
+        ) {
+            continue;
+        }
+        let name = &contact.tool.name;
+        let frozen = s.tool_work_frozen.get(c).and_then(Option::as_ref);
+        let Some(frozen) = frozen else {
+            return Err(Error::Input(format!(
+                "tool '{name}': its friction reads the tool's work, but the checkpoint holds no state.tool_work_frozen for it (written by a script without friction_of_tool_work)"
+            )));
+        };
+        if frozen.len() != fields.len() {
+            return Err(Error::Input(format!(
+                "the checkpoint's state.tool_work_frozen[{c}] (tool '{name}') has {} values, the grid {} cells",
+                frozen.len(),
+                fields.len()
+            )));
+        }
+        if let Some(v) = frozen.iter().find(|v| !(**v >= 0.0 && v.is_finite())) {
+            return Err(Error::Input(format!(
+                "the checkpoint's state.tool_work_frozen[{c}] (tool '{name}') holds {v}, but its values are finite and >= 0 (the file was edited or is damaged)"
+            )));
         }
     }
     Ok(())

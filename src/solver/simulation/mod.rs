@@ -9,6 +9,7 @@ pub mod kinematics_check;
 pub mod step_control;
 pub mod step_end;
 pub mod stepping;
+pub mod strokes;
 pub mod tool_fields;
 
 use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput};
@@ -38,6 +39,9 @@ pub struct IncrementReport {
     /// The step of the process this increment belongs to (`None` without steps).
     #[serde(default)]
     pub step: Option<usize>,
+    /// The stroke of a production run this increment belongs to, from 1 (`model::strokes`).
+    #[serde(default = "first_stroke")]
+    pub stroke: usize,
     pub time: f64,
     pub dt: f64,
     /// Number of linear solves.
@@ -93,6 +97,11 @@ pub struct IncrementReport {
     /// was asked and what was reached. The run stops there (module `step_end`).
     #[serde(default)]
     pub until_missed: Option<String>,
+}
+
+/// The stroke of reports written before strokes existed.
+fn first_stroke() -> usize {
+    1
 }
 
 /// Model plus its evolving, committed solution.
@@ -151,6 +160,14 @@ pub struct Simulation {
     /// Tool-side fields of each tool that asks for them (`Tool::fields`), accumulated in
     /// `commit`.
     pub(super) tool_fields: Vec<Option<tool_fields::ContactFields>>,
+    /// The current stroke, from 0 (module `strokes`). Part of the committed state.
+    pub(super) stroke: usize,
+    /// Per tool whose friction reads the tool's work (`FrictionLaw::ToolWork`): its work
+    /// per area frozen at the start of the stroke. Part of the committed state.
+    pub(super) tool_work_frozen: Vec<Option<Vec<f64>>>,
+    /// The state `new` built, where every stroke after the first starts; kept only when
+    /// several strokes are simulated.
+    pub(super) initial: Option<Box<SavedState>>,
 }
 
 impl Simulation {
@@ -184,6 +201,7 @@ impl Simulation {
         }
         force_control::check(&model)?;
         check_releases(&model)?;
+        strokes::check(&model)?;
         let dofs = DofMap::new(&model);
         let groups = crate::solver::linear::condense::elimination_groups(&model, &dofs);
         let pattern = Arc::new(dofs.pattern(&model).with_groups(groups));
@@ -236,7 +254,15 @@ impl Simulation {
             None
         };
         model.settings.stepping.validate(model.settings.end_time)?;
-        Ok(Simulation {
+        let tool_work_frozen = (model.contacts.iter().zip(&tool_fields))
+            .map(|(c, f)| match (&c.tool.friction, f) {
+                (crate::contact::FrictionLaw::ToolWork(_), Some(f)) => {
+                    Some(vec![0.0; f.fields.len()])
+                }
+                _ => None,
+            })
+            .collect();
+        let mut sim = Simulation {
             controller: StepController::new(&model),
             stops: schedule_stops(&model),
             saved: VecDeque::new(),
@@ -270,21 +296,29 @@ impl Simulation {
                 .collect(),
             step_ends: Vec::new(),
             tool_fields,
+            stroke: 0,
+            tool_work_frozen,
+            initial: None,
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
                 external_forces: initial_f_ext,
                 tool_forces: vec![Vec3::zeros(); model.contacts.len()],
             },
             model,
-        })
+        };
+        if sim.model.strokes.simulated > 1 {
+            sim.initial = Some(Box::new(sim.saved_state()));
+        }
+        Ok(sim)
     }
 
     pub fn time(&self) -> f64 {
         self.time
     }
 
+    /// Whether the run has ended: the end time reached in the last simulated stroke.
     pub fn is_finished(&self) -> bool {
-        self.time >= self.model.settings.end_time * (1.0 - 1e-12)
+        self.stroke_done() && self.is_last_stroke()
     }
 
     /// Fixed stepping's increment: `end_time / increments`, or in a process of steps the
@@ -594,6 +628,21 @@ impl Simulation {
                 let area = contact.areas[k];
                 if let Some(mu) = contact.tool.friction.mu(&s.friction_input(area)) {
                     s.mu = mu;
+                } else if let (
+                    crate::contact::FrictionLaw::ToolWork(law),
+                    Some(fields),
+                    Some(frozen),
+                ) = (
+                    &contact.tool.friction,
+                    &self.tool_fields[c],
+                    &self.tool_work_frozen[c],
+                ) {
+                    // The tool's state frozen at the stroke's start (module `strokes`).
+                    if let Some(mu) =
+                        strokes::tool_state_mu(law, &fields.fields, frozen, s.hint.as_ref())
+                    {
+                        s.mu = mu;
+                    }
                 }
                 s.theta = contact
                     .tool
@@ -644,6 +693,7 @@ impl Simulation {
         IncrementReport {
             index: self.increments_done,
             step: steps::step_at(&self.model.steps, t_new),
+            stroke: self.stroke + 1,
             time: t_new,
             dt,
             iterations,
@@ -690,6 +740,8 @@ impl Simulation {
                 .iter()
                 .map(|f| f.as_ref().map(|f| f.fields.values.clone()))
                 .collect(),
+            stroke: self.stroke,
+            tool_work_frozen: self.tool_work_frozen.clone(),
         }
     }
 
@@ -714,6 +766,13 @@ impl Simulation {
             if let (Some(f), Some(v)) = (fields.as_mut(), values) {
                 f.fields.values = v;
             }
+        }
+        self.stroke = state.stroke;
+        // Older checkpoints have no frozen work: the fields as restored (stroke 1: zero).
+        if state.tool_work_frozen.len() == self.tool_work_frozen.len() {
+            self.tool_work_frozen = state.tool_work_frozen;
+        } else {
+            self.tool_work_frozen = self.freeze_tool_work();
         }
     }
 

@@ -149,10 +149,18 @@ impl Simulation {
                 self.model.settings.end_time
             )));
         }
-        match self.model.settings.stepping.mode {
+        if self.stroke_done() {
+            // A production run: the next stroke on a new blank (module `strokes`).
+            self.start_next_stroke()?;
+        }
+        let report = match self.model.settings.stepping.mode {
             StepMode::Fixed => self.step_fixed(),
             StepMode::Adaptive => self.step_adaptive(),
+        }?;
+        if self.is_finished() && self.model.strokes.extrapolated() {
+            self.extrapolate_tool_fields();
         }
+        Ok(report)
     }
 
     /// One nominal increment of fixed stepping, in parts where Newton fails: a failed
