@@ -64,7 +64,8 @@ fn coulomb() -> FrictionLaw {
 
 /// Steps until the current stroke ends; returns the reports' tool forces.
 fn run_stroke(sim: &mut Simulation) -> Vec<[f64; 3]> {
-    let stroke = sim.stroke();
+    // The stroke this call runs: the next one when the current one has ended.
+    let stroke = sim.stroke() + usize::from(sim.stroke_done());
     let mut forces = Vec::new();
     loop {
         let r = sim.step().unwrap();
