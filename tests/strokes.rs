@@ -108,7 +108,10 @@ fn two_strokes_give_twice_the_fields_and_the_same_sheet() {
     let mut one = Simulation::new(roller(coulomb(), Strokes::default())).unwrap();
     let forces_one = run_stroke(&mut one);
     assert!(one.is_finished());
-    let mut sim = Simulation::new(roller(coulomb(), Strokes::new(2, 2).unwrap())).unwrap();
+    let mut model = roller(coulomb(), Strokes::new(2, 2).unwrap());
+    // Enough kept states to roll a whole stroke back (below).
+    model.settings.stepping.rollback_depth = 16;
+    let mut sim = Simulation::new(model).unwrap();
     let forces_1 = run_stroke(&mut sim);
     assert!(!sim.is_finished() && sim.stroke() == 1);
     // Stroke 1 of the production run is the run of one stroke, bit for bit.
@@ -154,6 +157,17 @@ fn two_strokes_give_twice_the_fields_and_the_same_sheet() {
     assert_eq!(sim.history.len(), 24);
     assert_eq!(sim.history[12].stroke, 2);
     assert_eq!(sim.history[12].index, 13);
+    // A rollback stays inside the stroke: to its start, not past it.
+    let err = sim.rollback(13).unwrap_err().to_string();
+    assert!(err.contains("past the start of stroke 2"), "{err}");
+    assert_eq!(sim.rollback(12).unwrap(), 0.0);
+    assert_eq!(sim.stroke(), 2);
+    assert!(sim.displacements().iter().all(|&u| u == 0.0));
+    assert_eq!(
+        sim.tool_fields(0).unwrap().values,
+        after_1,
+        "back at stroke 2's start: the fields stroke 1 left"
+    );
 }
 
 #[test]

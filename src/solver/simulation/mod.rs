@@ -538,6 +538,17 @@ impl Simulation {
                 self.model.settings.stepping.rollback_depth
             )));
         }
+        // A production run's strokes are separate blanks: the state kept before a stroke's
+        // first increment is the stroke's start, and no rollback goes past it (the frames
+        // and rows of the stroke before are not its own).
+        let target = &self.saved[self.saved.len() - n];
+        if target.stroke != self.stroke {
+            return Err(Error::Input(format!(
+                "cannot roll back {n} increment(s): that goes past the start of stroke {} (a new blank); at most {} in this stroke",
+                self.stroke + 1,
+                self.saved.iter().rev().take_while(|s| s.stroke == self.stroke).count()
+            )));
+        }
         let mut state = None;
         for _ in 0..n {
             state = self.saved.pop_back();
