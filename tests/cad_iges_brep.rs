@@ -13,7 +13,7 @@
 //! the NURBS forms are exact, so anything above that is a wrong surface.
 
 use tribo::cad::iges::faces_from_iges;
-use tribo::cad::{tool_surface, Face, ImportOptions};
+use tribo::cad::{choose_faces, tool_surface, Face, Facing, ImportOptions};
 use tribo::geometry::{RigidSurface, Vec3};
 
 fn text(name: &str) -> String {
@@ -230,6 +230,53 @@ fn shell_flags_turn_the_punch_faces_out_of_the_solid() {
         "{low:?}"
     );
     assert!((high.0.z - 58.0).abs() < 1e-9 && (high.1 - Vec3::z()).norm() < 1e-9);
+}
+
+/// Faces of a BRep file are chosen by the direction they face as STEP's are
+/// (tests/cad_face_choice.rs, same die): facing +z within 10 degrees, the top alone (at
+/// z = 0); within 90, the top and the 8 faces of the entry radius (z in [-8, 0]).
+#[test]
+fn brep_die_faces_are_chosen_by_facing() {
+    let die = faces("die_brep.igs");
+    assert_eq!(die.len(), 22);
+    let choose = |angle: f64| {
+        let options = ImportOptions {
+            facing: Some(Facing::new(Vec3::z(), angle, "test").unwrap()),
+            ..ImportOptions::default()
+        };
+        choose_faces("die_brep.igs", die.clone(), &options).unwrap()
+    };
+    let z_range = |f: &Face| {
+        let [[u0, u1], [v0, v1]] = f.surface.domain();
+        let mut r = (f64::INFINITY, f64::NEG_INFINITY);
+        for i in 0..9 {
+            for j in 0..9 {
+                let p = f.surface.point(
+                    u0 + (u1 - u0) * i as f64 / 8.0,
+                    v0 + (v1 - v0) * j as f64 / 8.0,
+                );
+                r = (r.0.min(p.z), r.1.max(p.z));
+            }
+        }
+        r
+    };
+    let top = choose(10.0);
+    assert_eq!(top.len(), 1);
+    let (lo, hi) = z_range(&top[0]);
+    assert!(
+        lo.abs() < 1e-12 && hi.abs() < 1e-12,
+        "top at z = 0: {lo} {hi}"
+    );
+    let up = choose(90.0);
+    assert_eq!(up.len(), 9);
+    for f in &up {
+        let (lo, hi) = z_range(f);
+        assert!(
+            lo > -8.0 - 1e-9 && hi < 1e-9,
+            "{}: z in [{lo}, {hi}]",
+            f.origin
+        );
+    }
 }
 
 /// What is not read is refused naming the entity, its type and D line (the file's line),

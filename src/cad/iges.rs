@@ -11,10 +11,14 @@
 //! - 124 transformation matrix on a surface or face (applied exactly to control points).
 //!
 //! - analytic surfaces a CAD exporter writes (in [`super::iges_analytic`]): 108 plane
-//!   and 190 plane surface (trimmed by its model-space curves) 120 surface of revolution and 122 tabulated cylinder, made exact NURBS.
+//!   and 190 plane surface (trimmed by its model-space curves), 120 surface of revolution
+//!   and 122 tabulated cylinder, made exact NURBS;
+//! - BRep (in [`super::iges_brep`]): 186 manifold solids, 514 shells, 510 faces on 190,
+//!   192, 194, 196, 198 or 128 surfaces, bounded by 508 loops of 504 edges.
 //!
-//! Faces are the 144 entities, and the 128, 120, 122 and bounded 108 entities no 144 or 142
-//! refers to, in directory order. Other surfaces (114, 118, 140, 143, 192-198) are
+//! Faces are the BRep faces (shell by shell, then the 510s no shell lists), then the 144
+//! entities, and the 128, 120, 122 and bounded 108 entities no 144, 142 or 510 refers to,
+//! in directory order. Other surfaces (114, 118, 140, 143, and 192-198 outside a 510) are
 //! refused naming the entity: export B-splines instead (OpenCascade:
 //! `BRepBuilderAPI_NurbsConvert`). Other entities (annotations, groups, model-space
 //! curves) are ignored. Every error names the file and the line (`file:line`),

@@ -282,17 +282,21 @@ impl Iges<'_> {
             if vertex {
                 continue; // a vertex use (a pole) bounds nothing
             }
+            let edge = format!(
+                "its edge {index} of {}",
+                Self::describe(self.entry(list, &p, "edge list")?)
+            );
             let chains = match surface {
                 BrepSurface::Analytic(a) => {
                     let curve = self.edge_curve(list, index, &p)?;
-                    self.edge_on_surface(a, &curve, list, index, &p)?
+                    self.edge_on_surface(a, &curve, &edge, &p)?
                 }
                 BrepSurface::Spline(_) => {
                     if curves.is_empty() {
                         return Err(p.fail(format!(
-                            "its edge {index} of the list at D line {list} has no \
-                             parameter-space curve on the face's 128 B-spline surface, which \
-                             is not read; write the file with parameter-space curves"
+                            "{edge} has no parameter-space curve on the face's 128 B-spline \
+                             surface, which is not read; write the file with parameter-space \
+                             curves"
                         )));
                     }
                     let mut segments = Vec::new();
@@ -341,19 +345,18 @@ impl Iges<'_> {
     }
 
     /// An edge's segments in the parameter plane of the analytic surface `a` (see the
-    /// module docs): each way of placing it on the periodic parameters' turns.
+    /// module docs): each way of placing it on the periodic parameters' turns; `edge`
+    /// names it in messages.
     fn edge_on_surface(
         &self,
         a: &Analytic,
         curve: &NurbsCurve,
-        list: i64,
-        index: usize,
+        edge: &str,
         p: &Params,
     ) -> Result<Vec<Vec<TrimSegment>>> {
         let off = || {
             p.fail(format!(
-                "its edge {index} of the list at D line {list} does not lie on the face's \
-                 surface (off by more than 1e-6 of its size)"
+                "{edge} does not lie on the face's surface (off by more than 1e-6 of its size)"
             ))
         };
         if let Analytic::Plane(f) = a {
@@ -367,8 +370,7 @@ impl Iges<'_> {
         let uv = isoparametric(a, curve).map_err(|e| match e {
             Unmapped::Off => off(),
             Unmapped::Curved => p.fail(format!(
-                "its edge {index} of the list at D line {list} is not a straight line of the \
-                 face's parameter plane (an isoparametric circle or line), which is not read on \
+                "{edge} is not a straight line of the face's parameter plane (an isoparametric circle or line), which is not read on \
                  a {}: convert the faces to B-splines (OpenCascade: BRepBuilderAPI_NurbsConvert) \
                  or export STEP",
                 match a {
