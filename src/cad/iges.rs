@@ -11,10 +11,14 @@
 //! - 124 transformation matrix on a surface or face (applied exactly to control points).
 //!
 //! - analytic surfaces a CAD exporter writes (in [`super::iges_analytic`]): 108 plane
-//!   and 190 plane surface (trimmed by its model-space curves) 120 surface of revolution and 122 tabulated cylinder, made exact NURBS.
+//!   and 190 plane surface (trimmed by its model-space curves), 120 surface of revolution
+//!   and 122 tabulated cylinder, made exact NURBS;
+//! - BRep (in [`super::iges_brep`]): 186 manifold solids, 514 shells, 510 faces on 190,
+//!   192, 194, 196, 198 or 128 surfaces, bounded by 508 loops of 504 edges.
 //!
-//! Faces are the 144 entities, and the 128, 120, 122 and bounded 108 entities no 144 or 142
-//! refers to, in directory order. Other surfaces (114, 118, 140, 143, 192-198) are
+//! Faces are the BRep faces (shell by shell, then the 510s no shell lists), then the 144
+//! entities, and the 128, 120, 122 and bounded 108 entities no 144, 142 or 510 refers to,
+//! in directory order. Other surfaces (114, 118, 140, 143, and 192-198 outside a 510) are
 //! refused naming the entity: export B-splines instead (OpenCascade:
 //! `BRepBuilderAPI_NurbsConvert`). Other entities (annotations, groups, model-space
 //! curves) are ignored. Every error names the file and the line (`file:line`),
@@ -70,9 +74,11 @@ fn name(kind: i64) -> &'static str {
         110 => "line",
         112 => "parametric spline curve",
         114 => "parametric spline surface",
+        116 => "point",
         118 => "ruled surface",
         120 => "surface of revolution",
         122 => "tabulated cylinder",
+        123 => "direction",
         124 => "transformation matrix",
         126 => "rational B-spline curve",
         128 => "rational B-spline surface",
@@ -86,6 +92,9 @@ fn name(kind: i64) -> &'static str {
         194 => "right circular conical surface",
         196 => "spherical surface",
         198 => "toroidal surface",
+        502 => "vertex list",
+        504 => "edge list",
+        508 => "loop",
         510 => "face",
         514 => "shell",
         _ => "entity",
@@ -93,7 +102,7 @@ fn name(kind: i64) -> &'static str {
 }
 
 /// Surfaces a CAD exporter may write that are not read (a face on one is refused).
-const UNREAD_SURFACES: [i64; 9] = [114, 118, 140, 143, 186, 192, 194, 196, 198];
+const UNREAD_SURFACES: [i64; 8] = [114, 118, 140, 143, 192, 194, 196, 198];
 
 /// Millimetres per unit of the global section's unit flag (IGES 5.3, parameter 14).
 fn unit_to_mm(flag: i64, unit_name: &str) -> Option<f64> {
@@ -482,6 +491,11 @@ impl<'a> Iges<'a> {
         Ok(entries)
     }
 
+    /// The directory entries, in order (entry `i` is at D line `2 i + 1`).
+    pub(super) fn entries(&self) -> &[Entry] {
+        &self.entries
+    }
+
     /// The entry a directory pointer (odd D line number) names.
     pub(super) fn entry(&self, pointer: i64, from: &Params, what: &str) -> Result<&Entry> {
         let index = usize::try_from(pointer - 1)
@@ -542,18 +556,19 @@ impl<'a> Iges<'a> {
         })
     }
 
-    /// The faces: 144 entities, and 128 entities that no 144 or 142 uses.
+    /// The faces: those of the BRep entities (186 solids, 514 shells, 510 faces:
+    /// [`super::iges_brep`]), the 144 entities, and the 128, 120, 122 and bounded 108
+    /// entities that no 144, 142 or 510 uses.
     fn faces(&self) -> Result<Vec<Face>> {
-        self.refuse_brep()?;
         let mut used = HashSet::new();
         for e in &self.entries {
-            if e.kind == 144 || e.kind == 142 {
+            if matches!(e.kind, 144 | 142 | 510) {
                 let p = self.params(e)?;
-                let k = if e.kind == 144 { 1 } else { 2 };
+                let k = if e.kind == 142 { 2 } else { 1 };
                 used.insert(p.int(k, "surface pointer")?);
             }
         }
-        let mut faces = Vec::new();
+        let mut faces = self.brep_faces()?;
         for (i, e) in self.entries.iter().enumerate() {
             let pointer = (2 * i + 1) as i64;
             match e.kind {
@@ -585,40 +600,18 @@ impl<'a> Iges<'a> {
         }
         if faces.is_empty() {
             return Err(Error::Input(format!(
-                "{}: no face (entity 128, 144, 120, 122 or bounded 108) in the file",
+                "{}: no face (entity 510, 128, 144, 120, 122 or bounded 108) in the file",
                 self.source
             )));
         }
         Ok(faces)
     }
 
-    /// A file in BRep mode (186 solids, 514 shells, 510 faces) is refused as a whole,
-    /// naming its first BRep entity: its faces' surfaces (190-198 among them) are bounded by
-    /// the 508 loops, which are not read, so any other message would blame a surface.
-    fn refuse_brep(&self) -> Result<()> {
-        match self
-            .entries
-            .iter()
-            .find(|e| matches!(e.kind, 186 | 514 | 510))
-        {
-            Some(e) => Err(Error::Input(format!(
-                "{}:{}: {}: IGES BRep (186 solid, 514 shell, 510 face, 508 loop, 504 edge, \
-                 502 vertex) is not read; write the IGES in faces mode (144 trimmed \
-                 surfaces; OpenCascade: write.iges.brep.mode = 0, its default), or export \
-                 STEP, whose analytic faces are read",
-                self.source,
-                e.file_line,
-                Self::describe(e)
-            ))),
-            None => Ok(()),
-        }
-    }
-
     fn unread_surface(&self, e: &Entry) -> Error {
         Error::Input(format!(
-            "{}:{}: {}: this surface type is not read; export the faces as rational \
-             B-spline surfaces (entity 128; OpenCascade: BRepBuilderAPI_NurbsConvert before \
-             writing)",
+            "{}:{}: {}: this surface type is not read (192-198 only as the surface of a 510 \
+             BRep face); export the faces as rational B-spline surfaces (entity 128; \
+             OpenCascade: BRepBuilderAPI_NurbsConvert before writing)",
             self.source,
             e.file_line,
             Self::describe(e)
@@ -647,7 +640,7 @@ impl<'a> Iges<'a> {
     }
 
     /// A 128 entity as a NURBS surface in mm, restricted to its parameter range.
-    fn surface(&self, e: &Entry) -> Result<NurbsSurface> {
+    pub(super) fn surface(&self, e: &Entry) -> Result<NurbsSurface> {
         let p = self.params(e)?;
         let k1 = p.count(1, "K1, upper index of u")?;
         let k2 = p.count(2, "K2, upper index of v")?;
@@ -772,7 +765,12 @@ impl<'a> Iges<'a> {
     }
 
     /// Appends the segments of a parameter-space curve (126, 110, 100, or 102 of those).
-    fn param_curve(&self, e: &Entry, out: &mut Vec<TrimSegment>, depth: usize) -> Result<()> {
+    pub(super) fn param_curve(
+        &self,
+        e: &Entry,
+        out: &mut Vec<TrimSegment>,
+        depth: usize,
+    ) -> Result<()> {
         let p = self.params(e)?;
         if e.matrix != 0 {
             return Err(p.fail(

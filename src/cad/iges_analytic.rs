@@ -90,7 +90,7 @@ impl Iges<'_> {
     /// A curve entity in its parent's space (its own 124 matrix applied), not scaled to mm:
     /// 110 line (parameter 0..1), 100 circular arc (parameter: the angle, from the start
     /// point's in `[0, 2 pi)`), 126 rational B-spline.
-    fn model_curve(&self, e: &Entry) -> Result<NurbsCurve> {
+    pub(super) fn model_curve(&self, e: &Entry) -> Result<NurbsCurve> {
         let p = self.params(e)?;
         let curve = match e.kind {
             110 => {

@@ -8,6 +8,7 @@
 
 pub mod iges;
 mod iges_analytic;
+mod iges_brep;
 pub mod nurbs_json;
 mod select;
 pub mod step;

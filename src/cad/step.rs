@@ -965,19 +965,7 @@ impl Step<'_> {
         face: usize,
         loops: &[Vec<TrimSegment>],
     ) -> Result<(NurbsSurface, [Option<f64>; 2])> {
-        let boxed = loops
-            .iter()
-            .flatten()
-            .map(|s| s.hull_box())
-            .reduce(|a, b| [0, 1].map(|d| [a[d][0].min(b[d][0]), a[d][1].max(b[d][1])]));
-        let extent = a.extent(boxed).ok_or_else(|| {
-            self.fail(
-                face,
-                "a face on an unbounded surface with no bounding loop".into(),
-            )
-        })?;
-        let (s, arcs) = a
-            .nurbs(extent)
+        let (s, arcs) = super::step_analytic::face_surface(a, loops)
             .map_err(|e| self.fail(face, super::strip(e)))?;
         let scale = crate::geometry::Mat3::identity() * self.to_mm;
         Ok((s.transformed(&scale, &Vec3::zeros()), arcs))
@@ -990,7 +978,7 @@ impl Step<'_> {
 /// has at most 6 options an edge and continuity prunes all but one or two, so the search
 /// is short (capped at 10^5 steps). Without such a chain, the greedy one (each option
 /// the nearest to the previous end), whose gap the trim region then reports.
-fn chain(edges: &[Vec<Vec<TrimSegment>>]) -> Vec<TrimSegment> {
+pub(super) fn chain(edges: &[Vec<Vec<TrimSegment>>]) -> Vec<TrimSegment> {
     let gap = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     let size = edges
         .iter()
@@ -1072,7 +1060,7 @@ fn segments_2d(c: &NurbsCurve) -> Vec<TrimSegment> {
 /// A space curve lying on a plane as trimming segments in the plane's `(u, v)`: the map
 /// `x -> ((x - c) . x_axis, (x - c) . y_axis)` is affine, so it acts exactly on the
 /// homogeneous control points.
-fn on_plane(c: &NurbsCurve, f: &Frame) -> Vec<TrimSegment> {
+pub(super) fn on_plane(c: &NurbsCurve, f: &Frame) -> Vec<TrimSegment> {
     c.segments()
         .into_iter()
         .map(|h| {

@@ -46,6 +46,7 @@ use super::step::{Step, Value};
 use super::step_curves::{Curve, Frame};
 use crate::geometry::analytic_nurbs::{extrusion_over, revolution, NurbsCurve};
 use crate::geometry::nurbs::NurbsSurface;
+use crate::geometry::trim::TrimSegment;
 use crate::geometry::Vec3;
 use crate::Result;
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -168,6 +169,55 @@ impl Analytic {
         }
     }
 
+    /// The parameters `(u, v)` of a point lying on the surface, in closed form (the
+    /// inverse of [`Analytic::point`]): the frame coordinates on a plane; on the axial
+    /// kinds `u = atan2(y, x)` in `(-pi, pi]` of the point's frame coordinates, and `v`
+    /// the height (cylinder, cone; the slant length on OpenCascade's cone), the latitude
+    /// `atan2(z, rho)` (sphere) or the tube angle `atan2(z, rho - R)` (torus), `rho` the
+    /// distance from the axis. `None` for surfaces of revolution and extrusions, whose
+    /// inverse needs a curve's.
+    pub fn parameters(&self, p: Vec3) -> Option<[f64; 2]> {
+        let local = |f: &Frame| {
+            let d = p - f.origin;
+            (d.dot(&f.x), d.dot(&f.y), d.dot(&f.z))
+        };
+        Some(match self {
+            Analytic::Plane(f) => {
+                let (x, y, _) = local(f);
+                [x, y]
+            }
+            Analytic::Cone {
+                frame,
+                semi_angle: a,
+                offset: d,
+                slant,
+                ..
+            } => {
+                let (x, y, z) = local(frame);
+                let [_, kz] = generatrix(*a, *slant);
+                [y.atan2(x), (z + d * a.sin()) / kz]
+            }
+            Analytic::Sphere { frame, .. } => {
+                let (x, y, z) = local(frame);
+                [y.atan2(x), z.atan2(x.hypot(y))]
+            }
+            Analytic::Torus { frame, major, .. } => {
+                let (x, y, z) = local(frame);
+                [y.atan2(x), z.atan2(x.hypot(y) - major)]
+            }
+            Analytic::Revolution { .. } | Analytic::Extrusion { .. } => return None,
+        })
+    }
+
+    /// True along `u` (index 0) or `v` (1) if the parameter is an angle of period `2 pi`
+    /// (a sphere's latitude is not: it stays within `[-pi/2, pi/2]`).
+    pub fn periodic(&self) -> [bool; 2] {
+        match self {
+            Analytic::Sphere { .. } => [true, false],
+            _ => self.angular(),
+        }
+    }
+
     /// The profile of an axial kind over `v` in `range`: a curve in the half plane of `x`
     /// and `z` whose turn about `z` is the surface.
     fn profile(&self, range: [f64; 2]) -> Option<Result<NurbsCurve>> {
@@ -284,6 +334,24 @@ impl Analytic {
         }
         Some(out)
     }
+}
+
+/// The exact NURBS of a face on `a` over the box of its trimming `loops` (in the surface's
+/// own unit), with its arc half angles; errs for a face on an unbounded surface with no
+/// loop. Shared by the STEP and IGES BRep readers.
+pub(super) fn face_surface(
+    a: &Analytic,
+    loops: &[Vec<TrimSegment>],
+) -> Result<(NurbsSurface, [Option<f64>; 2])> {
+    let boxed = loops
+        .iter()
+        .flatten()
+        .map(|s| s.hull_box())
+        .reduce(|a, b| [0, 1].map(|d| [a[d][0].min(b[d][0]), a[d][1].max(b[d][1])]));
+    let extent = a.extent(boxed).ok_or_else(|| {
+        crate::Error::Input("a face on an unbounded surface with no bounding loop".into())
+    })?;
+    a.nurbs(extent)
 }
 
 impl Step<'_> {
