@@ -400,6 +400,7 @@ impl Simulation {
     /// `attempt` says which (a last resort: no status prediction, [`LAST_RESORT_ITERATIONS`],
     /// no plain retry).
     fn try_increment(&mut self, t_new: f64, attempt: Attempt) -> Result<Trial> {
+        self.prepare_increment(t_new);
         // The factorization cache lives outside `self` while the context borrows it.
         let mut linear = std::mem::take(&mut self.linear);
         linear.set_threads(crate::solver::assembly::worker_threads(
