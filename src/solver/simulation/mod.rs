@@ -7,6 +7,7 @@ pub mod checkpoint;
 pub mod energy;
 pub mod kinematics_check;
 pub mod release;
+pub mod springback;
 pub mod step_control;
 pub mod step_end;
 pub mod stepping;
@@ -113,6 +114,11 @@ pub struct Simulation {
     /// The force schedules of the force-controlled tools as the model gave them, before
     /// a ramp-off step rewrote them (`release`).
     pub(super) base_forces: Vec<Option<crate::tool::ScalarSchedule>>,
+    /// The node positions where loading ended, kept for the springback measures
+    /// (`springback`); not in checkpoints.
+    pub(super) loaded_shape: Option<Vec<Vec3>>,
+    /// The springback of each release step completed (`springback`).
+    pub(super) springback: Vec<springback::Springback>,
     pub(super) linear: Solver,
     /// What the elements remembered at the last converged iterate (their linearisation
     /// there), where every attempt of the next increment starts
@@ -257,7 +263,9 @@ impl Simulation {
             has_release_steps: model
                 .steps
                 .iter()
-                .any(|s| !s.supports.is_empty() || !s.ramp_off.is_empty()),
+                .any(|s| !s.supports.is_empty() || !s.ramp_off.is_empty() || s.release),
+            loaded_shape: None,
+            springback: Vec::new(),
             base_forces: model
                 .contacts
                 .iter()

@@ -112,6 +112,7 @@ impl Simulation {
             return;
         }
         let step = steps::step_at(&self.model.steps, t_new);
+        self.keep_loaded_shape(step);
         self.set_supports(step);
         if let Some(k) = step {
             self.ramp_forces(k);

@@ -199,6 +199,7 @@ impl Simulation {
                 Ok(trial) => {
                     let mut report = self.accept(t_new, trial);
                     self.end_step_on_condition(&mut report);
+                    self.measure_springback(report.step);
                     note_last_resort(&mut report, attempt, &failures);
                     attempt = Attempt::Regular;
                     failures.clear();
@@ -306,6 +307,7 @@ impl Simulation {
                     }
                     let mut report = self.accept(t_new, trial);
                     self.end_step_on_condition(&mut report);
+                    self.measure_springback(report.step);
                     note_last_resort(&mut report, attempt, &failures);
                     cutbacks.report_since(0, &mut report);
                     report.rejected = rejected;
