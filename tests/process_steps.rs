@@ -358,12 +358,12 @@ fn bad_steps_are_refused_naming_the_step_and_the_value() {
         (
             "support_set",
             r#"[#{ name: "lift", duration: 1.0, supports: [["nowhere", "z"]] }]"#,
-            "step 0 ('lift') supports[0]: node set = \"nowhere\" is unknown",
+            "step 0 ('lift') supports[0]: invalid input: node set = \"nowhere\" is unknown",
         ),
         (
             "support_direction",
             r#"[#{ name: "lift", duration: 1.0, supports: [["z-", "xw"]] }]"#,
-            "step 0 ('lift') supports[0]: displacement component = 'w' in \"xw\" must be x, y or z",
+            "step 0 ('lift') supports[0]: invalid input: displacement component = 'w' in \"xw\" must be x, y or z",
         ),
         (
             "support_node",
