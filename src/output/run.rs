@@ -561,6 +561,9 @@ impl RunOutput {
         if let Some(map) = summary.as_object_mut() {
             if !sim.model.steps.is_empty() {
                 map.insert("steps".into(), steps_summary(sim, &self.frame_times));
+                if !sim.springback().is_empty() {
+                    map.insert("springback".into(), springback_summary(sim));
+                }
             }
             let strokes = sim.model.strokes;
             if strokes.total > 1 {
@@ -691,6 +694,20 @@ mod tests {
         assert!(!dead.exists() && alive.exists() && foreign.exists());
         let _ = std::fs::remove_dir_all(&root);
     }
+}
+
+/// summary.json's `springback`: per release step completed, its name and the largest and
+/// RMS nodal springback displacement from the end of loading, rigid part removed
+/// (solver `simulation::springback`).
+fn springback_summary(sim: &Simulation) -> serde_json::Value {
+    let entries = sim.springback().iter().map(|m| {
+        serde_json::json!({
+            "step": sim.model.steps[m.step].name,
+            "max_displacement": m.max,
+            "rms_displacement": m.rms,
+        })
+    });
+    serde_json::Value::Array(entries.collect())
 }
 
 /// summary.json's `steps`: per step of the process, its name, interval of pseudo-time and

@@ -11,8 +11,14 @@
 //!                               constant or piecewise linear in the fraction f in [0, 1]
 //!                               of the step
 //! axis: [ax, ay, az]            the force-control axis (the same in every step)
+//! ramp_off: true                force control along `axis` from the tool's last force
+//!                               to zero at the step's end (solver `simulation::release`)
 //! (tool not named)              held where it is
 //! ```
+//!
+//! A step's `supports: [[set_or_node, "xyz"], ...]` holds those node components where
+//! they are during the step; `supports: "3-2-1"` asks for the default chosen from the mesh
+//! (solver `rigid_modes::three_two_one`), and `[..., "3-2-1"]` for both.
 //!
 //! A step's `end_when: #{ tool: name, force: F }` or `end_when: #{ tool: name, contact: "lost" }`
 //! ends it at the first increment where the tool's contact force magnitude reaches `F`
@@ -32,7 +38,7 @@ use super::api_scene::scalar_schedule;
 use super::api_sim::ScriptSim;
 use super::convert::*;
 use crate::geometry::Vec3;
-use crate::solver::model::steps::{Condition, Step, Until};
+use crate::solver::model::steps::{Condition, Step, Support, Until};
 use crate::solver::model::Model;
 use crate::tool::{ForceControl, ScalarSchedule, Schedule};
 use rhai::{Array, Dynamic, Engine, Map};
@@ -44,6 +50,8 @@ struct ToolStep {
     /// (fraction of the step, force) points.
     force: Option<Vec<(f64, f64)>>,
     axis: Option<Vec3>,
+    /// The tool's force ramped from its last value to zero over the step.
+    ramp_off: bool,
 }
 
 pub fn register(engine: &mut Engine) {
@@ -83,7 +91,7 @@ fn compile(model: &mut Model, list: &Array) -> ScriptResult<()> {
                 "step {i}: expected a map #{{ name, duration, ... }}"
             ));
         };
-        let (step, plan) = read_step(i, &map, &names, end)?;
+        let (step, plan) = read_step(i, &map, &names, end, model)?;
         end = step.end;
         steps.push(step);
         plans.push(plan);
@@ -118,6 +126,7 @@ fn read_step(
     map: &Map,
     names: &[String],
     start: f64,
+    model: &Model,
 ) -> ScriptResult<(Step, Vec<ToolStep>)> {
     for key in map.keys() {
         if ![
@@ -127,11 +136,12 @@ fn read_step(
             "tools",
             "end_when",
             "release",
+            "supports",
         ]
         .contains(&key.as_str())
         {
             return runtime_error(format!(
-                "step {i}: unknown key '{key}' (expected name, duration, increments, tools, end_when, release)"
+                "step {i}: unknown key '{key}' (expected name, duration, increments, tools, end_when, release, supports)"
             ));
         }
     }
@@ -182,14 +192,80 @@ fn read_step(
             Err(_) => return runtime_error(format!("{at}: release = {v} must be true or false")),
         },
     };
+    let (supports, three_two_one) = match map.get("supports") {
+        None => (Vec::new(), false),
+        Some(v) => read_supports(&at, v, model)?,
+    };
     let step = Step {
         name,
         end: start + duration,
         increments,
         until,
         release,
+        supports,
+        three_two_one,
+        ramp_off: (0..names.len()).filter(|&c| plan[c].ramp_off).collect(),
     };
     Ok((step, plan))
+}
+
+/// A step's supports: `"3-2-1"`, or a list of `[set_or_node, "xyz"]` pairs and
+/// `"3-2-1"`. Returns the supports and whether the 3-2-1 default is asked for.
+fn read_supports(at: &str, v: &Dynamic, model: &Model) -> ScriptResult<(Vec<Support>, bool)> {
+    let expected = "expected \"3-2-1\" or [[set_or_node, \"xyz\"], ...]";
+    if let Ok(text) = v.clone().into_string() {
+        if text == "3-2-1" {
+            return Ok((Vec::new(), true));
+        }
+        return runtime_error(format!("{at} supports: \"{text}\" is unknown ({expected})"));
+    }
+    let Some(list) = v.clone().try_cast::<Array>() else {
+        return runtime_error(format!("{at} supports: {expected}"));
+    };
+    let (mut supports, mut default) = (Vec::new(), false);
+    for (j, item) in list.iter().enumerate() {
+        let here = format!("{at} supports[{j}]");
+        if item.clone().into_string().ok().as_deref() == Some("3-2-1") {
+            default = true;
+            continue;
+        }
+        let pair = item.clone().try_cast::<Array>().unwrap_or_default();
+        let [place, components] = pair.as_slice() else {
+            return runtime_error(format!("{here}: {expected}"));
+        };
+        let (label, nodes) = if let Ok(n) = place.as_int() {
+            let count = model.mesh.nodes.len();
+            if n < 0 || n as usize >= count {
+                return runtime_error(format!(
+                    "{here}: node {n} is not in the mesh ({count} nodes, 0 to {})",
+                    count.saturating_sub(1)
+                ));
+            }
+            (format!("node {n}"), vec![n as usize])
+        } else if let Ok(set) = place.clone().into_string() {
+            let nodes = model.nodes(&set).map_err(|e| format!("{here}: {e}"))?;
+            (set, nodes)
+        } else {
+            return runtime_error(format!(
+                "{here}: {place} is neither a node set's name nor a node number"
+            ));
+        };
+        let Ok(text) = components.clone().into_string() else {
+            return runtime_error(format!(
+                "{here}: the directions {components} must be a string such as \"xz\""
+            ));
+        };
+        let components =
+            crate::solver::model::parse_components(&text).map_err(|e| format!("{here}: {e}"))?;
+        for component in components {
+            supports.push(Support {
+                label: label.clone(),
+                nodes: nodes.clone(),
+                component,
+            });
+        }
+    }
+    Ok((supports, default))
 }
 
 /// A step's condition: `#{ tool: name, force: F }` (F > 0) or `#{ tool: name, contact:
@@ -250,6 +326,12 @@ fn read_tool_step(at: &str, spec: &Dynamic) -> ScriptResult<ToolStep> {
         match key.as_str() {
             "move" => out.movement = vec3(&array(at, key, v)?, &format!("{at} move"))?,
             "axis" => out.axis = Some(vec3(&array(at, key, v)?, &format!("{at} axis"))?),
+            "ramp_off" => match v.as_bool() {
+                Ok(b) => out.ramp_off = b,
+                Err(_) => {
+                    return runtime_error(format!("{at}: ramp_off = {v} must be true or false"))
+                }
+            },
             "force" => {
                 let points = scalar_schedule(v)
                     .map_err(|e| format!("{at} force: {e}"))?
@@ -264,13 +346,18 @@ fn read_tool_step(at: &str, spec: &Dynamic) -> ScriptResult<ToolStep> {
             }
             other => {
                 return runtime_error(format!(
-                    "{at}: unknown key '{other}' (expected move, force, axis)"
+                    "{at}: unknown key '{other}' (expected move, force, axis, ramp_off)"
                 ))
             }
         }
     }
     if out.force.is_some() && out.movement != Vec3::zeros() {
         return runtime_error(format!("{at}: give either move or force, not both"));
+    }
+    if out.ramp_off && (out.force.is_some() || out.movement != Vec3::zeros()) {
+        return runtime_error(format!(
+            "{at}: ramp_off sets the tool's force (from its last value to zero): give no move or force with it"
+        ));
     }
     Ok(out)
 }
@@ -304,11 +391,21 @@ fn force_control(
     let mut windows = Vec::new();
     for (k, (s, p)) in steps.iter().zip(plan).enumerate() {
         let at = format!("step {k} ('{}'), tool '{name}'", s.name);
-        if p.axis.is_some() && p.force.is_none() {
+        if p.axis.is_some() && p.force.is_none() && !p.ramp_off {
             return runtime_error(format!("{at}: an axis without a force"));
         }
-        let Some(force) = &p.force else { continue };
+        // A ramp's force is set as the run goes (solver `simulation::release`): its
+        // schedule here holds a zero at the step's end.
+        let ramp = [(1.0, 0.0)].to_vec();
+        let Some(force) = p.force.as_ref().or(p.ramp_off.then_some(&ramp)) else {
+            continue;
+        };
         match (axis, p.axis) {
+            (None, None) if p.ramp_off => {
+                return runtime_error(format!(
+                    "{at}: ramp_off needs the axis along which the tool pushes (axis: [ax, ay, az], here or in an earlier step)"
+                ))
+            }
             (None, None) => return runtime_error(format!("{at}: force control needs an axis")),
             (Some(a), Some(b)) if (a.normalize() - b.normalize()).norm() > 1e-12 => {
                 return runtime_error(format!(

@@ -14,7 +14,9 @@
 //! spacing), far above that threshold for any mesh of fewer than 10^4 elements per side.
 //! The check reads the constraints, never a message, and handles symmetry conditions as
 //! they are: a half model fixed in x on its symmetry plane needs supports only for the
-//! modes that leaves free.
+//! modes that leaves free. The same count chooses the 3-2-1 default supports of a step
+//! (`three_two_one`): candidate components are added one at a time and kept when the
+//! number of free modes drops.
 
 use super::Model;
 use crate::geometry::Vec3;
@@ -35,40 +37,130 @@ const MODES: [&str; 6] = [
 /// combination); empty when the supports hold the sheet. Rotations are about the nodes'
 /// centroid. O(fixed components).
 pub fn free_rigid_body_modes(model: &Model) -> Vec<String> {
+    Gram::new(model, dirichlet_components(model)).free_modes()
+}
+
+/// The rigid-body modes left free in step `k`: by the Dirichlet conditions and the step's
+/// own supports (`Step::supports`).
+pub fn free_rigid_body_modes_in_step(model: &Model, k: usize) -> Vec<String> {
+    let supports = model.steps[k]
+        .supports
+        .iter()
+        .flat_map(|s| s.nodes.iter().map(move |&n| (n, s.component)));
+    Gram::new(model, dirichlet_components(model).chain(supports)).free_modes()
+}
+
+/// The 3-2-1 default supports of step `k`: node components that, added to the Dirichlet
+/// conditions and the step's named supports, remove exactly the rigid-body modes they
+/// leave free, each one removing one (so none is redundant: at an equilibrium without
+/// tools their reactions vanish). Candidates, in order: the node `A` nearest the nodes'
+/// centroid, the node `B` farthest from `A`, the node `C` farthest from the line `AB`;
+/// each with its x, y and z, a component taken when it lowers the number of free modes
+/// (the rank of `G` rises by one). So a free sheet gets x, y, z at `A`, two components at
+/// `B` and one at `C` (3-2-1), and a symmetric plane-strain strip, whose conditions leave
+/// only the vertical translation free, gets z at `A` alone. Empty for an empty mesh.
+pub fn three_two_one(model: &Model, k: usize) -> Vec<(usize, usize)> {
     let nodes = &model.mesh.nodes;
     if nodes.is_empty() {
         return Vec::new();
     }
-    let c = nodes.iter().fold(Vec3::zeros(), |s, p| s + p) / nodes.len() as f64;
-    let size = nodes.iter().map(|p| (p - c).norm()).fold(0.0, f64::max);
-    let size = if size > 0.0 { size } else { 1.0 };
-    let mut g = Matrix6::<f64>::zeros();
-    for bc in &model.dirichlet {
-        for &n in &bc.nodes {
-            let row = mode_row(&((nodes[n] - c) / size), bc.component);
+    let named = model.steps[k]
+        .supports
+        .iter()
+        .flat_map(|s| s.nodes.iter().map(move |&n| (n, s.component)));
+    let mut constraints: Vec<(usize, usize)> = dirichlet_components(model).chain(named).collect();
+    let c = centroid(nodes);
+    let nearest = |key: &dyn Fn(&Vec3) -> f64| {
+        (0..nodes.len())
+            .min_by(|&a, &b| key(&nodes[a]).total_cmp(&key(&nodes[b])))
+            .unwrap_or(0)
+    };
+    let a = nearest(&|p| (p - c).norm());
+    let b = nearest(&|p| -(p - nodes[a]).norm());
+    let ab = (nodes[b] - nodes[a])
+        .try_normalize(0.0)
+        .unwrap_or(Vec3::x());
+    let c_node = nearest(&|p| -(p - nodes[a]).cross(&ab).norm());
+    let mut free = Gram::new(model, constraints.iter().copied())
+        .free_modes()
+        .len();
+    let mut chosen = Vec::new();
+    for node in [a, b, c_node] {
+        for component in 0..3 {
+            if free == 0 {
+                return chosen;
+            }
+            constraints.push((node, component));
+            let now = Gram::new(model, constraints.iter().copied())
+                .free_modes()
+                .len();
+            if now < free {
+                free = now;
+                chosen.push((node, component));
+            } else {
+                constraints.pop();
+            }
+        }
+    }
+    chosen
+}
+
+/// The fixed (node, component) pairs of the Dirichlet conditions.
+fn dirichlet_components(model: &Model) -> impl Iterator<Item = (usize, usize)> + '_ {
+    model
+        .dirichlet
+        .iter()
+        .flat_map(|bc| bc.nodes.iter().map(move |&n| (n, bc.component)))
+}
+
+fn centroid(nodes: &[Vec3]) -> Vec3 {
+    nodes.iter().fold(Vec3::zeros(), |s, p| s + p) / nodes.len().max(1) as f64
+}
+
+/// `G = A^T A` of a set of fixed components (module doc).
+struct Gram(Matrix6<f64>);
+
+impl Gram {
+    fn new(model: &Model, fixed: impl Iterator<Item = (usize, usize)>) -> Gram {
+        let nodes = &model.mesh.nodes;
+        let mut g = Matrix6::<f64>::zeros();
+        if nodes.is_empty() {
+            return Gram(g);
+        }
+        let c = centroid(nodes);
+        let size = nodes.iter().map(|p| (p - c).norm()).fold(0.0, f64::max);
+        let size = if size > 0.0 { size } else { 1.0 };
+        for (n, component) in fixed {
+            let row = mode_row(&((nodes[n] - c) / size), component);
             g += row * row.transpose();
         }
+        Gram(g)
     }
-    let tol = 1e-10 * (0..6).map(|j| g[(j, j)]).fold(1.0, f64::max);
-    // A mode no fixed component sees has a zero row and column in G: it is free on its
-    // own and named as it is; the null space of G on the other modes (combinations) is
-    // described by its eigenvectors.
-    let (pure, rest): (Vec<usize>, Vec<usize>) = (0..6).partition(|&j| g[(j, j)] <= tol);
-    let mut free: Vec<String> = pure.iter().map(|&j| MODES[j].to_string()).collect();
-    if rest.is_empty() {
-        // nalgebra's eigensolver refuses an empty matrix.
-        return free;
-    }
-    let sub = DMatrix::from_fn(rest.len(), rest.len(), |a, b| g[(rest[a], rest[b])]);
-    let eigen = SymmetricEigen::new(sub);
-    for k in (0..rest.len()).filter(|&k| eigen.eigenvalues[k] <= tol) {
-        let mut v = Vector6::zeros();
-        for (a, &j) in rest.iter().enumerate() {
-            v[j] = eigen.eigenvectors[(a, k)];
+
+    /// The modes in the null space of `G`, described (module doc).
+    fn free_modes(&self) -> Vec<String> {
+        let g = &self.0;
+        let tol = 1e-10 * (0..6).map(|j| g[(j, j)]).fold(1.0, f64::max);
+        // A mode no fixed component sees has a zero row and column in G: it is free on its
+        // own and named as it is; the null space of G on the other modes (combinations) is
+        // described by its eigenvectors.
+        let (pure, rest): (Vec<usize>, Vec<usize>) = (0..6).partition(|&j| g[(j, j)] <= tol);
+        let mut free: Vec<String> = pure.iter().map(|&j| MODES[j].to_string()).collect();
+        if rest.is_empty() {
+            // nalgebra's eigensolver refuses an empty matrix.
+            return free;
         }
-        free.push(describe(&v));
+        let sub = DMatrix::from_fn(rest.len(), rest.len(), |a, b| g[(rest[a], rest[b])]);
+        let eigen = SymmetricEigen::new(sub);
+        for k in (0..rest.len()).filter(|&k| eigen.eigenvalues[k] <= tol) {
+            let mut v = Vector6::zeros();
+            for (a, &j) in rest.iter().enumerate() {
+                v[j] = eigen.eigenvectors[(a, k)];
+            }
+            free.push(describe(&v));
+        }
+        free
     }
-    free
 }
 
 /// Component `i` of the six modes at the scaled position `r`: `e_i` for the translations,
@@ -177,5 +269,49 @@ mod tests {
         let free = free_rigid_body_modes(&model(&two));
         assert_eq!(free.len(), 1, "{free:?}");
         assert!(free[0].contains("rotation about x"), "{free:?}");
+    }
+
+    /// `model` with its 3-2-1 default supports of a one-step process added as Dirichlet
+    /// conditions (what the step holds).
+    fn with_three_two_one(mut model: Model) -> (Model, Vec<(usize, usize)>) {
+        model
+            .steps
+            .push(crate::solver::model::steps::Step::plain("release", 1.0, 1));
+        let chosen = three_two_one(&model, 0);
+        for &(n, component) in &chosen {
+            model.dirichlet.push(Dirichlet {
+                label: "3-2-1".into(),
+                nodes: vec![n],
+                component,
+                value: ScalarSchedule::constant(0.0),
+            });
+        }
+        (model, chosen)
+    }
+
+    #[test]
+    fn the_three_two_one_default_removes_exactly_the_free_modes() {
+        // A free block: six components, three at one node, two at a second, one at a third.
+        let (held, chosen) = with_three_two_one(model(&[]));
+        assert_eq!(chosen.len(), 6, "{chosen:?}");
+        let mut per_node: Vec<usize> = chosen
+            .iter()
+            .map(|&(n, _)| chosen.iter().filter(|c| c.0 == n).count())
+            .collect();
+        per_node.dedup();
+        assert_eq!(per_node, [3, 2, 1], "{chosen:?}");
+        assert!(free_rigid_body_modes(&held).is_empty());
+        // The symmetric plane-strain strip: its conditions leave the vertical translation
+        // free, and one vertical component holds it.
+        let x0 = |p: &Vec3| p.x == 0.0;
+        let y0 = |p: &Vec3| p.y == 0.0;
+        let y1 = |p: &Vec3| p.y == 1.0;
+        let strip = [(&x0 as &dyn Fn(&Vec3) -> bool, 0), (&y0, 1), (&y1, 1)];
+        let (held, chosen) = with_three_two_one(model(&strip));
+        assert_eq!(chosen.len(), 1, "{chosen:?}");
+        assert_eq!(chosen[0].1, 2, "a vertical support: {chosen:?}");
+        assert!(free_rigid_body_modes(&held).is_empty());
+        // A held model needs none.
+        assert!(with_three_two_one(held).1.is_empty());
     }
 }

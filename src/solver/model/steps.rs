@@ -20,6 +20,16 @@
 //! rebuilds the same schedules. A step whose end is reached without its condition stops
 //! the run (the increment report says so, `IncrementReport::until_missed`).
 //!
+//! A step may name supports (`Step::supports`): node components held where they are at
+//! the step's start, for that step only (`u_{n+1} = u_n` at every increment of the step,
+//! so a support never moves the sheet and a restart inside the step holds the same
+//! values, which are committed state), or ask for the 3-2-1 default
+//! (`Step::three_two_one`), chosen by `rigid_modes::three_two_one` from the mesh to remove
+//! exactly the rigid-body modes the other conditions leave free. A step may ramp tools
+//! off (`Step::ramp_off`): each named tool is force-controlled along its axis in the step
+//! with a force going linearly from its last contact force to zero at the step's end
+//! (solver `simulation::release`).
+//!
 //! Fixed stepping takes `(t_k - t_{k-1}) / n_k` in step `k` and never crosses a step end;
 //! adaptive stepping lands on every step end (`step_control::schedule_stops`). An increment
 //! ending at time `t` belongs to the step whose interval holds `t`.
@@ -40,6 +50,40 @@ pub struct Step {
     /// conditions) must then hold it statically determinate, which `Simulation::new`
     /// checks (`rigid_modes`).
     pub release: bool,
+    /// Supports acting in this step only: node components held where they are.
+    pub supports: Vec<Support>,
+    /// Whether the step adds the 3-2-1 default supports (resolved into `supports` when
+    /// the simulation starts).
+    pub three_two_one: bool,
+    /// Tools (indices into `Model::contacts`) whose force is ramped from its last value to
+    /// zero over the step; each is force-controlled in the step (`ForceControl::windows`).
+    pub ramp_off: Vec<usize>,
+}
+
+/// Components of nodes held where they are during one step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Support {
+    /// Where it comes from, for messages: a set's name, `node 12` or `3-2-1`.
+    pub label: String,
+    pub nodes: Vec<usize>,
+    /// 0, 1, 2 for x, y, z.
+    pub component: usize,
+}
+
+impl Step {
+    /// A step over `(previous end, end]` with `increments` and nothing else.
+    pub fn plain(name: &str, end: f64, increments: usize) -> Step {
+        Step {
+            name: name.to_string(),
+            end,
+            increments,
+            until: None,
+            release: false,
+            supports: Vec::new(),
+            three_two_one: false,
+            ramp_off: Vec::new(),
+        }
+    }
 }
 
 /// A condition ending a step: on tool `tool` (index into `Model::contacts`).
@@ -192,20 +236,8 @@ mod tests {
 
     fn steps() -> Vec<Step> {
         vec![
-            Step {
-                name: "closing".into(),
-                end: 1.0,
-                increments: 4,
-                until: None,
-                release: false,
-            },
-            Step {
-                name: "drawing".into(),
-                end: 21.0,
-                increments: 40,
-                until: None,
-                release: false,
-            },
+            Step::plain("closing", 1.0, 4),
+            Step::plain("drawing", 21.0, 40),
         ]
     }
 

@@ -58,6 +58,9 @@ pub struct Newton<'a> {
     pub(crate) pattern: &'a Arc<SparsePattern>,
     /// Whether each unknown is prescribed (a Dirichlet row).
     pub(crate) is_fixed: &'a [bool],
+    /// The rows of `is_fixed` held at their committed values (a step's supports,
+    /// `simulation::release`): every iterate starts there.
+    pub(crate) held: &'a [usize],
     /// The multiplier elimination, when there is one.
     pub(crate) condenser: Option<&'a Condenser>,
     /// The committed time and unknowns [u, lambda].
@@ -494,6 +497,9 @@ impl Newton<'_> {
         linear: &mut dyn LinearSolver,
         times: &mut PhaseTimes,
     ) -> Result<()> {
+        for &d in self.held {
+            x[d] = self.x[d];
+        }
         self.dirichlet_predictor(ctx, t_new, x, linear, times)?;
         for bc in &self.model.dirichlet {
             let v = bc.value.value(t_new);

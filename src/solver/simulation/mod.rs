@@ -6,6 +6,8 @@
 pub mod checkpoint;
 pub mod energy;
 pub mod kinematics_check;
+pub mod release;
+pub mod springback;
 pub mod step_control;
 pub mod step_end;
 pub mod stepping;
@@ -109,7 +111,23 @@ pub struct Simulation {
     pub model: Model,
     pub(super) dofs: DofMap,
     pub(super) pattern: Arc<SparsePattern>,
+    /// The prescribed rows of the increment under way or last committed: the Dirichlet
+    /// conditions' and its step's supports (`release`).
     pub(super) is_fixed: Vec<bool>,
+    /// The prescribed rows of the Dirichlet conditions alone.
+    pub(super) base_fixed: Vec<bool>,
+    /// The rows a step's supports hold at their committed values in that increment.
+    pub(super) held: Vec<usize>,
+    /// Whether some step has supports or ramps tools off (`release`).
+    pub(super) has_release_steps: bool,
+    /// The force schedules of the force-controlled tools as the model gave them, before
+    /// a ramp-off step rewrote them (`release`).
+    pub(super) base_forces: Vec<Option<crate::tool::ScalarSchedule>>,
+    /// The node positions where loading ended, kept for the springback measures
+    /// (`springback`); not in checkpoints.
+    pub(super) loaded_shape: Option<Vec<Vec3>>,
+    /// The springback of each release step completed (`springback`).
+    pub(super) springback: Vec<springback::Springback>,
     pub(super) linear: Solver,
     /// What the elements remembered at the last converged iterate (their linearisation
     /// there), where every attempt of the next increment starts
@@ -200,17 +218,12 @@ impl Simulation {
             }
         }
         force_control::check(&model)?;
-        check_releases(&model)?;
+        release::resolve_supports(&mut model)?;
         strokes::check(&model)?;
         let dofs = DofMap::new(&model);
         let groups = crate::solver::linear::condense::elimination_groups(&model, &dofs);
         let pattern = Arc::new(dofs.pattern(&model).with_groups(groups));
-        let mut is_fixed = vec![false; dofs.n_dofs];
-        for bc in &model.dirichlet {
-            for &node in &bc.nodes {
-                is_fixed[3 * node + bc.component] = true;
-            }
-        }
+        let (is_fixed, fixed_in_some_step) = release::fixed_rows(&model, dofs.n_dofs);
         let element = model.element()?;
         if model.settings.element == crate::element::ElementKind::SolidShell {
             crate::element::solid_shell::check_columns(&model.mesh)?;
@@ -249,7 +262,7 @@ impl Simulation {
         let dofs_nodes = dofs.n_nodes;
         let initial_f_ext = model.external_forces(0.0);
         let condenser = if model.settings.eliminate_multipliers {
-            Condenser::new(&model, &dofs, &pattern, &is_fixed)
+            Condenser::new(&model, &dofs, &pattern, &fixed_in_some_step)
         } else {
             None
         };
@@ -270,7 +283,20 @@ impl Simulation {
             x: vec![0.0; dofs.n_dofs],
             dofs,
             pattern,
+            base_fixed: is_fixed.clone(),
             is_fixed,
+            held: Vec::new(),
+            has_release_steps: model
+                .steps
+                .iter()
+                .any(|s| !s.supports.is_empty() || !s.ramp_off.is_empty() || s.release),
+            loaded_shape: None,
+            springback: Vec::new(),
+            base_forces: model
+                .contacts
+                .iter()
+                .map(|c| c.tool.force_control.as_ref().map(|f| f.force.clone()))
+                .collect(),
             linear: Solver::new(model.settings.linear_solver),
             committed_memory: Vec::new(),
             committed_forces: None,
@@ -414,6 +440,7 @@ impl Simulation {
             dofs: &self.dofs,
             pattern: &self.pattern,
             is_fixed: &self.is_fixed,
+            held: &self.held,
             condenser: self.condenser.as_ref(),
             time: self.time,
             x: &self.x,
@@ -772,6 +799,10 @@ impl Simulation {
         self.committed_memory = state.element_memory;
         self.committed_forces = None;
         self.set_step_ends(state.step_ends);
+        if self.has_release_steps {
+            // The prescribed rows of the committed increment's step (`release`).
+            self.set_supports(steps::step_at(&self.model.steps, self.time));
+        }
         // Shapes were checked by `Checkpoint::restore` (or come from this simulation).
         for (fields, values) in self.tool_fields.iter_mut().zip(state.tool_fields) {
             if let (Some(f), Some(v)) = (fields.as_mut(), values) {
@@ -869,24 +900,6 @@ impl Simulation {
         }
         Ok(())
     }
-}
-
-/// A step releasing the sheet from every tool needs supports that hold it: the rigid-body
-/// modes its Dirichlet conditions leave free (`rigid_modes`) are an error naming them.
-fn check_releases(model: &Model) -> Result<()> {
-    let Some((k, step)) = model.steps.iter().enumerate().find(|(_, s)| s.release) else {
-        return Ok(());
-    };
-    let free = crate::solver::model::rigid_modes::free_rigid_body_modes(model);
-    if free.is_empty() {
-        return Ok(());
-    }
-    Err(Error::Input(format!(
-        "step {k} ('{}') releases the sheet from every tool, but its supports leave {} rigid-body mode(s) free: {} (rotations about the nodes' centroid); fix them with sim.fix (for instance the missing components at one, two and three nodes: 3-2-1)",
-        step.name,
-        free.len(),
-        free.join("; ")
-    )))
 }
 
 /// The one warning of a run about contact-status cycling, on one line: how many nodes, that

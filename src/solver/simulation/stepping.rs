@@ -207,6 +207,7 @@ impl Simulation {
                 Ok(trial) => {
                     let mut report = self.accept(t_new, trial);
                     self.end_step_on_condition(&mut report);
+                    self.measure_springback(report.step);
                     note_last_resort(&mut report, attempt, &failures);
                     attempt = Attempt::Regular;
                     failures.clear();
@@ -314,6 +315,7 @@ impl Simulation {
                     }
                     let mut report = self.accept(t_new, trial);
                     self.end_step_on_condition(&mut report);
+                    self.measure_springback(report.step);
                     note_last_resort(&mut report, attempt, &failures);
                     cutbacks.report_since(0, &mut report);
                     report.rejected = rejected;
@@ -408,6 +410,7 @@ impl Simulation {
     /// `attempt` says which (a last resort: no status prediction, [`LAST_RESORT_ITERATIONS`],
     /// no plain retry).
     fn try_increment(&mut self, t_new: f64, attempt: Attempt) -> Result<Trial> {
+        self.prepare_increment(t_new);
         // The factorization cache lives outside `self` while the context borrows it.
         let mut linear = std::mem::take(&mut self.linear);
         linear.set_threads(crate::solver::assembly::worker_threads(
