@@ -381,6 +381,10 @@ impl SimState {
         self.simulation()?;
         self.write_due_checkpoint()?;
         let sim = self.sim.as_mut().expect("started");
+        if sim.is_finished() {
+            // Not a failure: the run ended well and its summary stays as written.
+            return runtime_error(after_the_end(sim));
+        }
         match sim.step() {
             Ok(report) => {
                 self.failure = None;
@@ -921,6 +925,26 @@ fn register_stepping(engine: &mut Engine, host: &Rc<HostOptions>) {
             rollback(s, n as usize)
         },
     );
+}
+
+/// The message for `sim.step()` after the run's end: what happened, then the fix.
+fn after_the_end(sim: &Simulation) -> String {
+    let end = sim.model.settings.end_time;
+    let done = sim.history.len();
+    if sim.model.steps.is_empty() {
+        format!(
+            "sim.step(): the run already reached its end time {end} (increment {done}); \
+             nothing is left to step\n  to go on, raise the end time first: \
+             sim.settings(#{{ end_time: {} }})",
+            2.0 * end
+        )
+    } else {
+        format!(
+            "sim.step(): the process already finished its last step at time {end} \
+             (increment {done}); nothing is left to step\n  to go on, add a step to sim.steps([...]) \
+             before the run"
+        )
+    }
 }
 
 /// `sim.step()`: one increment and its report; the summary is written when it ends the
