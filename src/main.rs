@@ -135,6 +135,16 @@ struct SweepArgs {
     /// (commands.txt) into the sweep's folder.
     #[arg(long, value_name = "slurm|parallel")]
     emit: Option<String>,
+    /// With --emit slurm: each task's wall-time limit, as Slurm writes it (minutes,
+    /// H:M:S or D-H:M:S).
+    /// Default: 04:00:00.
+    #[arg(long, value_name = "TIME")]
+    time: Option<String>,
+    /// With --emit slurm: each task's memory (4G, 16000M); each run is also given it as
+    /// --max-memory-mb, so a mesh too large for it is refused with a message.
+    /// Default: 4G.
+    #[arg(long, value_name = "SIZE")]
+    mem: Option<String>,
     /// No line per finished run.
     #[arg(long)]
     quiet: bool,
@@ -162,6 +172,31 @@ enum SweepCollect {
     },
 }
 
+/// `--time` and `--mem` of `tribo sweep`: a Slurm job array's only (elsewhere they would
+/// be silently ignored).
+fn slurm_resources(
+    target: Option<tribo::sweep::emit::Target>,
+    time: Option<&str>,
+    mem: Option<&str>,
+) -> tribo::Result<tribo::sweep::emit::SlurmResources> {
+    use tribo::sweep::emit::{SlurmResources, Target};
+    if target != Some(Target::Slurm) {
+        if let Some(flag) = [("--time", time), ("--mem", mem)]
+            .iter()
+            .find_map(|(flag, v)| v.map(|_| flag))
+        {
+            return Err(tribo::Error::Input(format!(
+                "{flag} is what each task of a Slurm job array asks for: it goes with --emit \
+                 slurm only"
+            )));
+        }
+    }
+    SlurmResources::parse(
+        time.unwrap_or(SlurmResources::DEFAULT_TIME),
+        mem.unwrap_or(SlurmResources::DEFAULT_MEM),
+    )
+}
+
 fn sweep(args: SweepArgs) -> tribo::Result<()> {
     use tribo::sweep;
     if let Some(SweepCollect::Collect { dir, x, y, series }) = args.collect {
@@ -176,11 +211,16 @@ fn sweep(args: SweepArgs) -> tribo::Result<()> {
     };
     let this = std::env::current_exe()
         .map_err(|e| tribo::Error::Input(format!("sweep: own binary: {e}")))?;
+    let target = args
+        .emit
+        .as_deref()
+        .map(sweep::emit::Target::from_name)
+        .transpose()?;
+    let slurm = slurm_resources(target, args.time.as_deref(), args.mem.as_deref())?;
     let plan = sweep::Sweep::new(&script, &table, &out, &this)?;
-    match args.emit {
+    match target {
         Some(target) => {
-            let target = sweep::emit::Target::from_name(&target)?;
-            println!("{}", sweep::emit::write(&plan, target, args.jobs)?);
+            println!("{}", sweep::emit::write(&plan, target, args.jobs, &slurm)?);
             Ok(())
         }
         None => {

@@ -39,6 +39,7 @@ fn a_stop_gives_its_reason_first_and_details_below() {
         details.iter().any(|l| l.contains("checkpoints/final.json")),
         "where the state was saved: {err}"
     );
+    assert!(!err.contains("Young's modulus"), "no units note at E = 1000: {err}");
     // The first line carries the script's path and position before the reason (a temporary
     // folder here, some 45 characters); the one line was 455 characters before.
     for line in &lines[at..] {
@@ -48,4 +49,28 @@ fn a_stop_gives_its_reason_first_and_details_below() {
             line.len()
         );
     }
+}
+
+/// A stop before any increment converged, with a sheet metal's modulus written in GPa in a
+/// model of mm and N (the default units), says what the number means; named other units,
+/// or no stop, say nothing of it.
+#[test]
+fn a_first_increment_stop_with_a_modulus_in_gpa_suggests_the_units() {
+    let soft = STOPS.replace("linear_elastic(1000.0, 0.3)", "linear_elastic(210.0, 0.3)");
+    let (code, err) = common::run_script("units-note", "gpa", &soft, &[]);
+    assert_eq!(code, 1, "{err}");
+    let note = err
+        .lines()
+        .find(|l| l.contains("note: Young's modulus"))
+        .unwrap_or_else(|| panic!("no units note: {err}"));
+    assert!(
+        note.starts_with("  note: Young's modulus 210.0 in a model of mm and N is 210.0 MPa")
+            && note.contains("times 1,000"),
+        "{note}"
+    );
+    let metres = soft.replace("kinematics: \"small\"", "kinematics: \"small\", units: #{ length: \"m\" }");
+    assert!(metres.contains("units"), "the replacement took");
+    let (code, err) = common::run_script("units-note", "metres", &metres, &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(!err.contains("Young's modulus"), "{err}");
 }

@@ -112,3 +112,44 @@ fn a_set_selected_after_the_simulation_says_why_it_is_unknown() {
     let (code, err) = common::run_script("early-set", "early", &src, &[]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// Re-selecting a set the simulation already holds used to change the script's mesh only,
+/// and the run went on with the old set unnoticed.
+#[test]
+fn reselecting_a_set_after_the_simulation_is_refused() {
+    let src = "let mesh = block([0, 0, 0], [1, 1, 1], [2, 2, 2]);\n\
+               mesh.select(\"top\", |x, y, z| z > 0.9);\n\
+               let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n\
+               mesh.select(\"top\", |x, y, z| z < 0.1);\n\
+               sim.fix(\"top\", \"z\");\n";
+    let (code, err) = common::run_script("reselect", "reselect", src, &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("mesh.select(\"top\", ...): the set \"top\" already exists")
+            && err.contains("select under a new name")
+            && err.contains(":4:"),
+        "{err}"
+    );
+}
+
+/// `sim.step()` after the end time was reported as a failure to converge, and overwrote
+/// the finished run's summary with a stop.
+#[test]
+fn stepping_after_the_end_says_so_and_how_to_go_on() {
+    let src = "let mesh = block([0, 0, 0], [10, 10, 2], [2, 2, 1]);\n\
+               let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n\
+               sim.fix(\"z-\", \"xyz\");\n\
+               sim.load(\"z+\", [0.0, 0.0, -10.0], [[0.0, 0.0], [1.0, 1.0]]);\n\
+               sim.settings(#{ end_time: 1.0, increments: 2 });\n\
+               sim.run();\n\
+               let after = \"stepped\";\n\
+               try { sim.step(); } catch (e) { after = \"\" + e; }\n\
+               assert(after.contains(\"already reached its end time 1 (increment 2)\"), after);\n\
+               assert(after.contains(\"sim.settings(#{ end_time: 2 })\"), after);\n\
+               assert(!after.contains(\"no convergence\"), after);\n\
+               sim.settings(#{ end_time: 2.0 });\n\
+               let r = sim.step();\n\
+               assert(r.time == 2.0, \"raising the end time steps on: \" + r.time);\n";
+    let (code, err) = common::run_script("after-end", "after_end", src, &[]);
+    assert_eq!(code, 0, "{err}");
+}

@@ -178,6 +178,14 @@ fn local_jobs_one_by_one_parallel_file_and_slurm_array_agree_and_collect_charts(
         "{text}"
     );
     assert!(directives.contains(&"#SBATCH --ntasks=1"), "{text}");
+    // The default wall time and memory, and each run told its memory.
+    assert!(directives.contains(&"#SBATCH --time=04:00:00"), "{text}");
+    assert!(directives.contains(&"#SBATCH --mem=4096M"), "{text}");
+    let commands = std::fs::read_to_string(slurm.join("commands.txt")).unwrap();
+    assert!(
+        commands.lines().all(|l| l.contains(" --max-memory-mb 4096 ")),
+        "{commands}"
+    );
     assert!(text.contains("SLURM_ARRAY_TASK_ID") && text.contains("commands.txt"));
     let task = 7;
     bash(&job, Some(task));
@@ -235,4 +243,42 @@ fn local_jobs_one_by_one_parallel_file_and_slurm_array_agree_and_collect_charts(
     let points = std::fs::read_to_string(chart.with_extension("csv")).unwrap();
     assert_eq!(points.lines().count(), n + 1, "{points}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--time` and `--mem` reach the job array as Slurm reads them; bad values, or the flags
+/// without `--emit slurm`, are refused before anything is written.
+#[test]
+fn slurm_time_and_memory_are_settable_and_checked() {
+    let dir = std::env::temp_dir().join(format!("tribo-sweep-res-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = dir.join("mu.csv");
+    std::fs::write(&table, "mu,cells,increments\n0.1,8,6\n0.2,8,6\n").unwrap();
+    let (script, table) = (script(), table.display().to_string());
+    let script = script.display().to_string();
+    let out = dir.join("ok");
+    let out_s = out.display().to_string();
+    let args = ["sweep", &script, &table, "--out", &out_s, "--emit", "slurm"];
+    tribo(&[&args[..], &["--time", "1-12:00:00", "--mem", "16G"]].concat());
+    let text = std::fs::read_to_string(out.join("sweep.slurm")).unwrap();
+    assert!(text.contains("\n#SBATCH --time=1-12:00:00\n"), "{text}");
+    assert!(text.contains("\n#SBATCH --mem=16384M\n"), "{text}");
+    let commands = std::fs::read_to_string(out.join("commands.txt")).unwrap();
+    assert_eq!(commands.matches(" --max-memory-mb 16384 ").count(), 2, "{commands}");
+
+    let refused = |extra: &[&str], folder: &str, said: &str| {
+        let out = dir.join(folder);
+        let out_s = out.display().to_string();
+        let mut all = vec!["sweep", &script, &table, "--out", &out_s];
+        all.extend_from_slice(extra);
+        let run = Command::new(BIN).args(&all).output().unwrap();
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{all:?}: {err}");
+        assert!(err.contains(said), "{all:?}: {err}");
+        assert!(!out.exists(), "{all:?} wrote its folder before refusing");
+    };
+    refused(&["--emit", "slurm", "--time", "4h"], "t", "--time 4h: not a Slurm time limit");
+    refused(&["--emit", "slurm", "--mem", "4GB"], "m", "--mem 4GB: not a Slurm memory size");
+    refused(&["--emit", "parallel", "--mem", "4G"], "p", "--mem is what each task");
+    refused(&["--time", "10"], "l", "--time is what each task");
 }

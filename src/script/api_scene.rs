@@ -196,6 +196,16 @@ fn register_mesh(engine: &mut Engine, host: &std::rc::Rc<super::HostOptions>) {
         "select",
         move |ctx: NativeCallContext, m: &mut Mesh, name: &str, pred: FnPtr| -> ScriptResult<i64> {
             if !h.simulations.is_empty() {
+                if m.node_set(name).is_ok() {
+                    // The simulation holds its own copy of the mesh: a changed set would
+                    // reach this mesh only, and the run would use the old one unnoticed.
+                    return runtime_error(format!(
+                        "mesh.select(\"{name}\", ...): the set \"{name}\" already exists and a \
+                         simulation was built from this mesh before this call, so it would keep \
+                         the old set\n  select under a new name, or make the selection before \
+                         simulation(mesh, ...)"
+                    ));
+                }
                 h.late_sets.borrow_mut().insert(name.to_string());
             }
             let mut chosen = Vec::new();

@@ -381,6 +381,10 @@ impl SimState {
         self.simulation()?;
         self.write_due_checkpoint()?;
         let sim = self.sim.as_mut().expect("started");
+        if sim.is_finished() {
+            // Not a failure: the run ended well and its summary stays as written.
+            return runtime_error(after_the_end(sim));
+        }
         match sim.step() {
             Ok(report) => {
                 self.failure = None;
@@ -401,7 +405,15 @@ impl SimState {
                         ),
                     };
                 }
-                fail(err)
+                let sim = self.sim.as_ref().expect("started");
+                match units_hint(sim, &self.frames.units) {
+                    Some(hint) => Err(Box::new(rhai::EvalAltResult::ErrorRuntime(
+                        // A clause of its own, which the host puts on a line of its own.
+                        format!("{err}; {hint}").into(),
+                        rhai::Position::NONE,
+                    ))),
+                    None => fail(err),
+                }
             }
         }
     }
@@ -924,6 +936,52 @@ fn register_stepping(engine: &mut Engine, host: &Rc<HostOptions>) {
             rollback(s, n as usize)
         },
     );
+}
+
+/// Young's modulus below which a model in mm and N (the default units) is suspect: 1,000
+/// MPa is softer than any sheet metal by a factor of 40 and stiffer than rubbers and foams,
+/// whose models are written knowingly.
+const SUSPECT_MODULUS_MPA: f64 = 1000.0;
+
+/// For a stop before any increment converged: when the sheet's Young's modulus reads as a
+/// sheet metal's in GPa (or Pa) in a model of mm and N, the line that says so. The modulus
+/// is read from the elastic tangent as 1 / (C^-1)_11, exact for isotropic elasticity.
+fn units_hint(sim: &Simulation, units: &crate::output::Units) -> Option<String> {
+    let in_mm_n = matches!(units.length.as_str(), "" | "mm") && matches!(units.force.as_str(), "" | "N");
+    if !sim.history.is_empty() || !in_mm_n {
+        return None;
+    }
+    let young = 1.0 / sim.model.material.elastic_tangent().try_inverse()?[(0, 0)];
+    (young.is_finite() && young > 0.0 && young < SUSPECT_MODULUS_MPA).then(|| {
+        // Four significant digits: 210.0, 0.2100.
+        let decimals = (4 - young.log10().ceil() as i32).max(0) as usize;
+        let young = format!("{young:.decimals$}");
+        format!(
+            "note: Young's modulus {young} in a model of mm and N is {young} MPa (steel \
+             210,000 MPa, aluminium 70,000): if it was meant in GPa, write it times 1,000, \
+             or name other units with sim.settings(#{{ units: ... }})"
+        )
+    })
+}
+
+/// The message for `sim.step()` after the run's end: what happened, then the fix.
+fn after_the_end(sim: &Simulation) -> String {
+    let end = sim.model.settings.end_time;
+    let done = sim.history.len();
+    if sim.model.steps.is_empty() {
+        format!(
+            "sim.step(): the run already reached its end time {end} (increment {done}); \
+             nothing is left to step\n  to go on, raise the end time first: \
+             sim.settings(#{{ end_time: {} }})",
+            2.0 * end
+        )
+    } else {
+        format!(
+            "sim.step(): the process already finished its last step at time {end} \
+             (increment {done}); nothing is left to step\n  to go on, add a step to sim.steps([...]) \
+             before the run"
+        )
+    }
 }
 
 /// `sim.step()`: one increment and its report; the summary is written when it ends the

@@ -267,6 +267,45 @@ impl PhaseTimes {
         self.approximate_evaluations += other.approximate_evaluations;
         self.newton_steps += other.newton_steps;
     }
+
+    /// Adds `other`'s times, not its counts.
+    pub fn add_times(&mut self, other: &PhaseTimes) {
+        self.elements += other.elements;
+        self.contact += other.contact;
+        self.factorization_and_solve += other.factorization_and_solve;
+    }
+
+    /// The counts alone (no times), as a checkpoint keeps them.
+    pub fn counts(&self) -> EvaluationCounts {
+        EvaluationCounts {
+            full: self.full_evaluations,
+            residual_only: self.residual_evaluations,
+            jacobian_completions: self.jacobian_completions,
+            with_approximate_local_solves: self.approximate_evaluations,
+            newton_steps: self.newton_steps,
+        }
+    }
+
+    /// Sets the counts (the times stay: they are this process's own).
+    pub fn set_counts(&mut self, c: &EvaluationCounts) {
+        self.full_evaluations = c.full;
+        self.residual_evaluations = c.residual_only;
+        self.jacobian_completions = c.jacobian_completions;
+        self.approximate_evaluations = c.with_approximate_local_solves;
+        self.newton_steps = c.newton_steps;
+    }
+}
+
+/// The evaluations and Newton steps of [`PhaseTimes`] without its times: what a run did up
+/// to a committed state, carried by checkpoints so that a restarted run's summary counts
+/// what the uninterrupted run counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct EvaluationCounts {
+    pub full: usize,
+    pub residual_only: usize,
+    pub jacobian_completions: usize,
+    pub with_approximate_local_solves: usize,
+    pub newton_steps: usize,
 }
 
 /// Frozen contact frame of a pair (foot point and normal in the tool's frame at the start of

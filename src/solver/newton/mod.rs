@@ -73,6 +73,10 @@ pub struct Newton<'a> {
     pub(crate) committed_memory: &'a [f64],
     /// The committed state's element forces, when kept (`committed_residual`).
     pub(crate) committed_forces: Option<&'a [f64]>,
+    /// The committed forces were dropped by a restore (restart or rollback), where the run
+    /// that reached this state had them: the element pass that recovers them is timed but
+    /// not counted, so that a restarted run counts the evaluations of the uninterrupted one.
+    pub(crate) forces_lost_by_restore: bool,
     /// The last converged increment (dt, change of the displacements), for the predictor.
     pub(crate) last_step: Option<&'a (f64, Vec<f64>)>,
     /// Stop request polled between iterations.
@@ -528,6 +532,12 @@ impl Newton<'_> {
         match &self.committed_forces {
             Some(f_int) if plain[..n_u] == self.x[..n_u] => {
                 ctx.residual_with_forces(plain, f_int.to_vec(), times)
+            }
+            None if self.forces_lost_by_restore && plain[..n_u] == self.x[..n_u] => {
+                let mut own = PhaseTimes::default();
+                let eval = ctx.evaluate_residual(plain, &mut own)?;
+                times.add_times(&own);
+                Ok(eval)
             }
             _ => ctx.evaluate_residual(plain, times),
         }

@@ -176,6 +176,11 @@ pub struct Checkpoint {
     /// Values the script kept (`sim.keep`), restored with the state.
     #[serde(default)]
     pub script: serde_json::Map<String, serde_json::Value>,
+    /// The evaluations and Newton steps up to the committed state, so that a restarted
+    /// run's summary counts them as the uninterrupted run does (absent from older
+    /// checkpoints: the restarted run counts its own only).
+    #[serde(default)]
+    pub evaluations: Option<crate::solver::assembly::EvaluationCounts>,
 }
 
 impl Checkpoint {
@@ -196,6 +201,7 @@ impl Checkpoint {
             state,
             frame_times,
             script: serde_json::Map::new(),
+            evaluations: Some(sim.committed_counts),
         }
     }
 
@@ -315,6 +321,10 @@ impl Checkpoint {
         }
         sim.history = self.history;
         sim.restore_state(self.state);
+        if let Some(counts) = self.evaluations {
+            sim.phase_times.set_counts(&counts);
+            sim.committed_counts = counts;
+        }
         sim.clear_rollback();
         Ok(())
     }

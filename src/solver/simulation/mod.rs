@@ -18,7 +18,7 @@ use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput
 use crate::geometry::Vec3;
 use crate::material::PointState;
 use crate::solver::assembly::force_control;
-use crate::solver::assembly::{DofMap, Evaluation, PhaseTimes};
+use crate::solver::assembly::{DofMap, EvaluationCounts, Evaluation, PhaseTimes};
 use crate::solver::linear::condense::Condenser;
 use crate::solver::linear::{LinearSolver, Solver};
 use crate::solver::model::{steps, Model};
@@ -138,6 +138,9 @@ pub struct Simulation {
     /// element pass (`Newton::committed_residual`); `None` before the first increment
     /// and after a restore.
     pub(super) committed_forces: Option<Vec<f64>>,
+    /// `committed_forces` were dropped by a restore of a state that had them
+    /// (`Newton::forces_lost_by_restore`).
+    pub(super) forces_lost_by_restore: bool,
     pub(super) condenser: Option<Condenser>,
     /// Committed unknowns [u, lambda].
     pub(super) x: Vec<f64>,
@@ -149,6 +152,9 @@ pub struct Simulation {
     /// Time and evaluations of every attempt so far: accepted increments, and the attempts
     /// that failed (cut back) or that adaptive stepping rejected.
     pub phase_times: PhaseTimes,
+    /// `phase_times`' counts at the last committed increment (checkpoints carry them: the
+    /// attempts after it are redone by a restarted run).
+    pub(super) committed_counts: EvaluationCounts,
     pub(super) energy: EnergyBalance,
     pub(super) energy_memory: EnergyMemory,
     pub(super) controller: StepController,
@@ -300,12 +306,14 @@ impl Simulation {
             linear: Solver::new(model.settings.linear_solver),
             committed_memory: Vec::new(),
             committed_forces: None,
+            forces_lost_by_restore: false,
             points,
             contact,
             time: 0.0,
             increments_done: 0,
             history: Vec::new(),
             phase_times: PhaseTimes::default(),
+            committed_counts: EvaluationCounts::default(),
             energy: EnergyBalance {
                 frictional_dissipation: vec![0.0; model.contacts.len()],
                 ..Default::default()
@@ -448,6 +456,7 @@ impl Simulation {
             contact: &self.contact,
             committed_memory: &self.committed_memory,
             committed_forces: self.committed_forces.as_deref(),
+            forces_lost_by_restore: self.forces_lost_by_restore,
             last_step: self.last_step.as_ref(),
             interrupt: &self.interrupt,
         }
@@ -516,6 +525,7 @@ impl Simulation {
             self.saved.push_back(state);
         }
         self.phase_times.add(&trial.times);
+        self.committed_counts = self.phase_times.counts();
         // The accepted attempt's steps are its iterations; the rest of its `times` (a
         // status-prediction attempt before a plain retry) was discarded.
         let discarded = std::mem::take(&mut self.discarded_steps)
@@ -726,6 +736,7 @@ impl Simulation {
         self.x = x;
         self.points = eval.trial_points;
         self.committed_forces = Some(eval.f_int);
+        self.forces_lost_by_restore = false;
         self.time = t_new;
         self.increments_done += 1;
         IncrementReport {
@@ -798,6 +809,7 @@ impl Simulation {
         self.last_step = state.last_step;
         self.committed_memory = state.element_memory;
         self.committed_forces = None;
+        self.forces_lost_by_restore = state.increments_done > 0;
         self.set_step_ends(state.step_ends);
         if self.has_release_steps {
             // The prescribed rows of the committed increment's step (`release`).
