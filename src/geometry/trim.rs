@@ -391,6 +391,30 @@ mod tests {
         assert!(!region.contains(7.0 + s + 1e-6, 7.0 + s + 1e-6));
     }
 
+    /// `to_piece` inverts `to_face`, along straight and circular directions alike.
+    #[test]
+    fn piece_parameters_map_to_the_face_and_back() {
+        let region = std::sync::Arc::new(TrimRegion::new(vec![rounded_square(1.0, 0.5)]).unwrap());
+        for arcs in [[None, None], [Some(std::f64::consts::FRAC_PI_4), Some(0.3)]] {
+            let trim = PieceTrim {
+                region: region.clone(),
+                u: [0.2, 0.7],
+                v: [-1.0, 0.5],
+                arcs,
+            };
+            for (s, t) in [(0.0, 0.0), (0.3, 0.9), (1.0, 0.5), (0.77, 1.0)] {
+                let [u, v] = trim.to_face(s, t);
+                let back = trim.to_piece(u, v);
+                // Round-off of tan/atan on values of order 1.
+                assert!(
+                    (back[0] - s).abs() < 1e-14 && (back[1] - t).abs() < 1e-14,
+                    "{arcs:?}: ({s}, {t}) -> ({u}, {v}) -> {back:?}"
+                );
+            }
+            assert!(trim.to_face(0.0, 1.0) == [0.2, 0.5] && trim.to_face(1.0, 0.0) == [0.7, -1.0]);
+        }
+    }
+
     #[test]
     fn open_loops_are_refused_and_rectangles_recognised() {
         let mut open = rounded_square(10.0, 3.0);

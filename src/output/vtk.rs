@@ -569,7 +569,7 @@ mod tests {
     /// Component names are on the right arrays (a point and a cell field may share a name),
     /// and quadrilaterals round-trip after the hexahedra.
     #[test]
-    fn vtu_component_names_and_quads_round_trip() {
+    fn vtu_component_names_quads_and_triangles_round_trip() {
         let dir = temp_dir("vtu-names");
         let path = dir.join("named.vtu");
         let mut frame = two_hex_frame();
@@ -578,10 +578,11 @@ mod tests {
                 .named_components(&["a", "b&c", "d"]),
         );
         frame.quads = vec![[0, 1, 7, 6], [1, 2, 8, 7]];
+        frame.triangles = vec![[3, 4, 10], [4, 5, 11], [9, 10, 11]];
         frame.cell_data = (frame.cell_data.into_iter())
             .map(|mut f| {
                 let per = f.components;
-                let extra: Vec<f64> = (0..2 * per).map(|i| i as f64).collect();
+                let extra: Vec<f64> = (0..5 * per).map(|i| i as f64).collect();
                 f.values.extend(extra);
                 f
             })
@@ -598,7 +599,7 @@ mod tests {
             SYMMETRIC_TENSOR_COMPONENTS
         );
         assert_eq!(back.point_data[2].component_names, ["a", "b&c", "d"]);
-        assert_eq!(back.quads.len(), 2);
+        assert_eq!((back.quads.len(), back.triangles.len()), (2, 3));
         // vtkio's own reader still accepts the tags with the extra attributes.
         assert!(Vtk::import(&path).is_ok());
 
