@@ -104,3 +104,71 @@ let top = sim.contact_node("floor", 31);
         tribo::solver::simulation::checkpoint::Checkpoint::from_json(&text, "final.json").unwrap();
     assert_eq!(ck.history.len(), 4);
 }
+
+/// `sim.history()` and `sim.node_history` at 20 402 nodes (a 100 x 100 x 1 block pressed on
+/// a floor by 1e-3, one increment; one is enough: neither grows with the mesh): records
+/// that read like the maps they replace, for the last of the 10 201 candidates.
+#[test]
+fn history_and_node_history_at_ten_thousand_candidates() {
+    run_script(
+        "big_history.rhai",
+        r#"
+let mesh = block([0, 0, 0], [100, 100, 2], [100, 100, 1]);
+assert(mesh.n_nodes == 20402, `${mesh.n_nodes} nodes`);
+let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
+sim.add_tool(tool("floor", plane([0, 0, 0], [0, 0, 1])).friction(coulomb(0.1)), "z-");
+sim.prescribe("z+", "z", [[0.0, 0.0], [1.0, -1e-3]]);
+sim.settings(#{ end_time: 1.0, increments: 1, output_every: 0 });
+sim.run();
+let rows = sim.history();
+assert(rows.len() == 1 && rows[0].index == 1 && rows[0]["time"] == 1.0, `history: ${rows}`);
+assert("iterations" in rows[0] && rows[0].keys().len() == rows[0].to_map().len(), "keys");
+assert(rows[0].active_nodes == 101 * 101, `every candidate presses: ${rows[0].active_nodes}`);
+let last = sim.contact_nodes("floor")[101 * 101 - 1].node;
+let h = sim.node_history("floor", last);
+assert(h.len() == 1 && h[0].increment == 1 && h[0].status != "gap", `node ${last}: ${h}`);
+"#,
+    );
+}
+
+/// A run of 4 000 increments (one hexahedron pressed on a floor): `sim.history()`, 19
+/// entries an increment and a map of one entry per tool for forces and offsets (21 here),
+/// is past Rhai's 65 536 map entries, where its array of maps stopped (at 3 120 increments
+/// here); its last record goes into summary.json as its map.
+#[test]
+fn history_of_more_increments_than_the_map_limit() {
+    run_script(
+        "long_history.rhai",
+        r#"
+let mesh = block([0, 0, 0], [1, 1, 1], [1, 1, 1]);
+let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
+sim.add_tool(tool("floor", plane([0, 0, 0], [0, 0, 1])).friction(coulomb(0.1)), "z-");
+sim.prescribe("z+", "z", [[0.0, 0.0], [1.0, -1e-3]]);
+sim.fix("z+", "x");
+sim.fix("z+", "y");
+sim.settings(#{ end_time: 1.0, increments: 4000, output_interval: 0.5 });
+sim.run();
+let rows = sim.history();
+assert(rows.len() == 4000, `${rows.len()} reports`);
+let entries = 0;
+for r in rows { entries += r.keys().len(); }
+assert(entries > 65536, `${entries} entries in all`);
+assert(rows[3999].index == 4000 && (rows[3999].time - 1.0).abs() < 1e-9, `${rows[3999]}`);
+let node = sim.contact_nodes("floor")[0].node;
+let h = sim.node_history("floor", node);
+assert(h.len() == 4000 && h[3999].increment == 4000, `${h.len()} entries`);
+sim.summary("last_row", rows[3999]);
+"#,
+    );
+}
+
+/// Runs `source` as the script `name` in a fresh folder; panics with the script's error.
+fn run_script(name: &str, source: &str) {
+    let dir = TestDir::new(&format!("tribo-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&*dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, source).unwrap();
+    if let Err(e) = script::run_file(&path, &[], &host(&dir.join("out"))) {
+        panic!("{e}");
+    }
+}

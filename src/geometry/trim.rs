@@ -227,6 +227,11 @@ impl TrimRegion {
         })
     }
 
+    /// The trimming loops, each a closed chain of segments.
+    pub fn loops(&self) -> &[Vec<TrimSegment>] {
+        &self.loops
+    }
+
     /// True if the only loop is the rectangle `u x v` itself (so nothing is trimmed away).
     pub fn is_rectangle(&self, u: [f64; 2], v: [f64; 2]) -> bool {
         let tol = 1e-9 * ((u[1] - u[0]).abs() + (v[1] - v[0]).abs());
@@ -276,12 +281,38 @@ fn fraction(s: f64, arc: Option<f64>) -> f64 {
     }
 }
 
+/// The inverse of [`fraction`]: the piece's own parameter at fraction `f`,
+/// `s = 1/2 + tan(h (f - 1/2)) / (2 tan(h / 2))` along an arc (defined for
+/// `|f - 1/2| < pi / (2 h)`, which holds on and near the piece, `h <= pi / 2`).
+fn unfraction(f: f64, arc: Option<f64>) -> f64 {
+    match arc {
+        None => f,
+        Some(h) => 0.5 + (h * (f - 0.5)).tan() / (2.0 * (0.5 * h).tan()),
+    }
+}
+
 impl PieceTrim {
     /// True if the piece's point `(s, t)` is on the trimmed face.
     pub fn admits(&self, s: f64, t: f64) -> bool {
-        let u = self.u[0] + fraction(s, self.arcs[0]) * (self.u[1] - self.u[0]);
-        let v = self.v[0] + fraction(t, self.arcs[1]) * (self.v[1] - self.v[0]);
+        let [u, v] = self.to_face(s, t);
         self.region.contains(u, v)
+    }
+
+    /// The face's parameters `(u, v)` of the piece's point `(s, t)`.
+    pub fn to_face(&self, s: f64, t: f64) -> [f64; 2] {
+        [
+            self.u[0] + fraction(s, self.arcs[0]) * (self.u[1] - self.u[0]),
+            self.v[0] + fraction(t, self.arcs[1]) * (self.v[1] - self.v[0]),
+        ]
+    }
+
+    /// The piece's parameters `(s, t)` of the face's point `(u, v)` (the inverse of
+    /// [`PieceTrim::to_face`]; for points on or near the piece).
+    pub fn to_piece(&self, u: f64, v: f64) -> [f64; 2] {
+        [
+            unfraction((u - self.u[0]) / (self.u[1] - self.u[0]), self.arcs[0]),
+            unfraction((v - self.v[0]) / (self.v[1] - self.v[0]), self.arcs[1]),
+        ]
     }
 }
 
@@ -358,6 +389,30 @@ mod tests {
         let s = FRAC_1_SQRT_2 * 3.0;
         assert!(region.contains(7.0 + s, 7.0 + s));
         assert!(!region.contains(7.0 + s + 1e-6, 7.0 + s + 1e-6));
+    }
+
+    /// `to_piece` inverts `to_face`, along straight and circular directions alike.
+    #[test]
+    fn piece_parameters_map_to_the_face_and_back() {
+        let region = std::sync::Arc::new(TrimRegion::new(vec![rounded_square(1.0, 0.5)]).unwrap());
+        for arcs in [[None, None], [Some(std::f64::consts::FRAC_PI_4), Some(0.3)]] {
+            let trim = PieceTrim {
+                region: region.clone(),
+                u: [0.2, 0.7],
+                v: [-1.0, 0.5],
+                arcs,
+            };
+            for (s, t) in [(0.0, 0.0), (0.3, 0.9), (1.0, 0.5), (0.77, 1.0)] {
+                let [u, v] = trim.to_face(s, t);
+                let back = trim.to_piece(u, v);
+                // Round-off of tan/atan on values of order 1.
+                assert!(
+                    (back[0] - s).abs() < 1e-14 && (back[1] - t).abs() < 1e-14,
+                    "{arcs:?}: ({s}, {t}) -> ({u}, {v}) -> {back:?}"
+                );
+            }
+            assert!(trim.to_face(0.0, 1.0) == [0.2, 0.5] && trim.to_face(1.0, 0.0) == [0.7, -1.0]);
+        }
     }
 
     #[test]

@@ -199,6 +199,7 @@ pub fn frame_against(
             .collect(),
         hexes: mesh.hexes.clone(),
         quads: Vec::new(),
+        triangles: Vec::new(),
         point_data: vec![
             Field::new("displacement", 3, u.to_vec()),
             Field::scalar("contact_status", contact.status),

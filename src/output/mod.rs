@@ -28,6 +28,7 @@ pub mod svg;
 mod tool_fields;
 mod tool_frame;
 pub mod tool_map;
+mod trim_tessellation;
 mod vtk;
 
 pub mod run;
@@ -42,7 +43,7 @@ pub use self::previous_run::{
 pub use self::pvd::{PvdEntry, PvdSeries};
 pub use self::run::{OutputOptions, RunOutput, Units};
 pub use self::summary::{write_summary, SUMMARY_FILE};
-pub use self::tool_frame::tool_frame;
+pub use self::tool_frame::{tool_frame, DisplayRegion, TRIM_TOLERANCE};
 pub use self::vtk::{
     read_vtu, read_vtu_point_field, write_vtu, Field, Frame, SYMMETRIC_TENSOR_COMPONENTS,
 };

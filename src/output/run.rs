@@ -83,6 +83,9 @@ pub struct OutputOptions {
     pub model_fraction: f64,
     /// The forming limit curve and zone thresholds of the formability fields.
     pub formability: super::formability::FormabilityOptions,
+    /// Chord tolerance (a length) of the trimming curves of trimmed tools in the frames;
+    /// `None`: [`super::tool_frame::TRIM_TOLERANCE`] of each trimmed patch's size.
+    pub trim_tolerance: Option<f64>,
 }
 
 impl OutputOptions {
@@ -95,6 +98,7 @@ impl OutputOptions {
             units: Units::default(),
             model_fraction: 1.0,
             formability: Default::default(),
+            trim_tolerance: None,
         }
     }
 }
@@ -354,9 +358,9 @@ impl RunOutput {
             let with_fields = (sim.tool_fields(c))
                 .zip(contact.tool.surface.as_patch_surface())
                 .map(|(f, surface)| super::tool_fields::frame(surface, f, &pose));
-            if let Some(tool) =
-                with_fields.or_else(|| tool_frame::tool_frame(&contact.tool, &pose, &region))
-            {
+            if let Some(tool) = with_fields.or_else(|| {
+                tool_frame::tool_frame(&contact.tool, &pose, &region, self.frames.trim_tolerance)
+            }) {
                 let (_, file) = tool_files.next().expect("one file per shown tool");
                 write_vtu(&self.folder.resolve_for_write(file)?, &tool)?;
             }

@@ -13,14 +13,20 @@
 //! [`DisplayRegion`] is the blank's reference box (fixed, so that the display moves only
 //! with the tool's pose).
 
+use super::trim_tessellation::{self, Cover};
 use super::{Field, Frame};
 use crate::geometry::analytic_nurbs::{revolution, NurbsCurve};
+use crate::geometry::trim::PieceTrim;
 use crate::geometry::{AnalyticShape, BezierPatch, Vec3};
 use crate::tool::{Pose, Tool};
 
 /// Quadrilaterals along a curved patch direction: a 90 degree arc in 8 chords of 11.25
 /// degrees, within 0.5 % of the radius.
 pub const SAMPLES_CURVED: usize = 8;
+
+/// Default chord tolerance of drawn trimming curves, relative to the size (bounding-box
+/// diagonal) of the patch they cut: 0.25 mm on the 180 mm die's top face.
+pub const TRIM_TOLERANCE: f64 = 1e-3;
 
 /// Angle (rad) by which a sphere's display stops short of its poles.
 const POLE_GAP: f64 = 1e-4;
@@ -55,23 +61,67 @@ impl DisplayRegion {
 }
 
 /// The display surface of `tool` at `pose`, with the point field `normal` (the outward unit
-/// normal of the exact surface at each sample, for smooth shading); `None` for a surface that is neither patches nor analytic.
-pub fn tool_frame(tool: &Tool, pose: &Pose, region: &DisplayRegion) -> Option<Frame> {
+/// normal of the exact surface at each sample, for smooth shading); `None` for a surface
+/// that is neither patches nor analytic. A trimmed patch is drawn within its trims with
+/// boundary chords within `trim_tolerance` (a length; `None`: [`TRIM_TOLERANCE`] of the
+/// patch's size) of its trimming curves.
+pub fn tool_frame(
+    tool: &Tool,
+    pose: &Pose,
+    region: &DisplayRegion,
+    trim_tolerance: Option<f64>,
+) -> Option<Frame> {
     let analytic;
-    let patches: &[BezierPatch] = match tool.surface.as_patch_surface() {
-        Some(surface) => surface.patches(),
-        None => {
-            analytic = analytic_patches(&tool.surface.analytic_shape()?, region);
-            &analytic
-        }
-    };
+    let (patches, trims): (&[BezierPatch], &[Option<PieceTrim>]) =
+        match tool.surface.as_patch_surface() {
+            Some(surface) => (surface.patches(), surface.trims()),
+            None => {
+                analytic = analytic_patches(&tool.surface.analytic_shape()?, region);
+                (&analytic, &[])
+            }
+        };
     let mut frame = Frame::default();
     let mut normals: Vec<[f64; 3]> = Vec::new();
-    for patch in patches {
-        add_patch(&mut frame, &mut normals, patch, pose);
+    for (k, patch) in patches.iter().enumerate() {
+        match trims.get(k).and_then(Option::as_ref) {
+            None => add_patch(&mut frame, &mut normals, patch, pose),
+            Some(trim) => {
+                add_trimmed_patch(&mut frame, &mut normals, patch, trim, pose, trim_tolerance)
+            }
+        }
     }
     frame.point_data.push(Field::vector("normal", &normals));
     Some(frame)
+}
+
+/// Appends the part of `patch` on its trimmed face (see [`super::trim_tessellation`]): the
+/// whole grid where no trimming curve enters the patch, nothing where the patch is off the
+/// face, else triangles.
+fn add_trimmed_patch(
+    frame: &mut Frame,
+    normals: &mut Vec<[f64; 3]>,
+    patch: &BezierPatch,
+    trim: &PieceTrim,
+    pose: &Pose,
+    tolerance: Option<f64>,
+) {
+    let (p, q) = patch.degrees();
+    let (su, sv) = (samples(p), samples(q));
+    let tolerance = tolerance.unwrap_or_else(|| {
+        let (lo, hi) = patch.bounding_box();
+        TRIM_TOLERANCE * (hi - lo).norm()
+    });
+    match trim_tessellation::cover(patch, trim, su, sv, tolerance) {
+        Cover::Whole => add_patch_grid(frame, normals, patch, pose, su, sv),
+        Cover::Empty => {}
+        Cover::Triangles { points, triangles } => {
+            let first = frame.points.len();
+            for [s, t] in points {
+                push_sample(frame, normals, patch, pose, s, t);
+            }
+            (frame.triangles).extend(triangles.iter().map(|c| c.map(|i| first + i)));
+        }
+    }
 }
 
 /// Exact patches of an analytic surface's displayed part (see the module docs), normals
@@ -150,14 +200,14 @@ pub(super) fn add_patch_grid(
     let first = frame.points.len();
     for i in 0..=su {
         for j in 0..=sv {
-            let (u, v) = (i as f64 / su as f64, j as f64 / sv as f64);
-            let e = patch.evaluate(u, v);
-            let x = pose.to_global_point(&e.point);
-            let n = patch
-                .normal(&e)
-                .map_or(Vec3::zeros(), |n| pose.to_global_vector(&n));
-            frame.points.push([x.x, x.y, x.z]);
-            normals.push([n.x, n.y, n.z]);
+            push_sample(
+                frame,
+                normals,
+                patch,
+                pose,
+                i as f64 / su as f64,
+                j as f64 / sv as f64,
+            );
         }
     }
     let id = |i: usize, j: usize| first + i * (sv + 1) + j;
@@ -168,6 +218,25 @@ pub(super) fn add_patch_grid(
                 .push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
         }
     }
+}
+
+/// Appends the point of `patch` at `(u, v)` placed at `pose`, and its unit normal (zero
+/// where the normal is undefined).
+fn push_sample(
+    frame: &mut Frame,
+    normals: &mut Vec<[f64; 3]>,
+    patch: &BezierPatch,
+    pose: &Pose,
+    u: f64,
+    v: f64,
+) {
+    let e = patch.evaluate(u, v);
+    let x = pose.to_global_point(&e.point);
+    let n = patch
+        .normal(&e)
+        .map_or(Vec3::zeros(), |n| pose.to_global_vector(&n));
+    frame.points.push([x.x, x.y, x.z]);
+    normals.push([n.x, n.y, n.z]);
 }
 
 #[cfg(test)]
@@ -194,7 +263,7 @@ mod tests {
             &Vec3::new(0.0, 0.0, -3.0),
         );
         let region = DisplayRegion::around(&[]);
-        let f = tool_frame(&tool, &pose, &region).unwrap();
+        let f = tool_frame(&tool, &pose, &region, None).unwrap();
         assert_eq!((f.points.len(), f.quads.len()), (4, 1));
         for (k, (u, v)) in [(0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0)]
             .into_iter()
@@ -232,7 +301,7 @@ mod tests {
         ];
         for surface in surfaces {
             let tool = Tool::new("analytic", surface.clone());
-            let f = tool_frame(&tool, &pose, &region).unwrap();
+            let f = tool_frame(&tool, &pose, &region, None).unwrap();
             f.validate().unwrap();
             let normals = &f.point_data[0].values;
             let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);

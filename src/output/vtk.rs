@@ -28,6 +28,9 @@ pub struct Frame {
     pub hexes: Vec<[usize; 8]>,
     /// 4-node quadrilaterals (VTK_QUAD), after the hexahedra in the file's cell order.
     pub quads: Vec<[usize; 4]>,
+    /// 3-node triangles (VTK_TRIANGLE), after the quadrilaterals in the file's cell order
+    /// (the trimmed parts of a tool's display surface).
+    pub triangles: Vec<[usize; 3]>,
     /// Fields with one tuple per point.
     pub point_data: Vec<Field>,
     /// Fields with one tuple per cell (hexahedra first, then quadrilaterals).
@@ -89,9 +92,9 @@ impl Field {
 }
 
 impl Frame {
-    /// Number of cells (hexahedra and quadrilaterals).
+    /// Number of cells (hexahedra, quadrilaterals and triangles).
     pub fn cell_count(&self) -> usize {
-        self.hexes.len() + self.quads.len()
+        self.hexes.len() + self.quads.len() + self.triangles.len()
     }
 
     /// Checks that every cell references existing points and that every field has a non-empty
@@ -106,6 +109,12 @@ impl Frame {
                     .iter()
                     .enumerate()
                     .map(|(i, q)| (i, ("quadrilateral", &q[..]))),
+            )
+            .chain(
+                self.triangles
+                    .iter()
+                    .enumerate()
+                    .map(|(i, t)| (i, ("triangle", &t[..]))),
             );
         for (i, (kind, nodes)) in cells {
             if let Some(&bad) = nodes.iter().find(|&&n| n >= np) {
@@ -198,14 +207,13 @@ pub fn write_vtu(path: &Path, frame: &Frame) -> Result<()> {
     let points: Vec<f64> = frame.points.iter().flatten().copied().collect();
     let connectivity: Vec<u64> = (frame.hexes.iter().flatten())
         .chain(frame.quads.iter().flatten())
+        .chain(frame.triangles.iter().flatten())
         .map(|&n| n as u64)
         .collect();
-    let offsets: Vec<u64> = (1..=frame.hexes.len() as u64)
-        .map(|i| 8 * i)
-        .chain((1..=frame.quads.len() as u64).map(|i| 8 * frame.hexes.len() as u64 + 4 * i))
-        .collect();
+    let offsets = cell_offsets(frame.hexes.len(), frame.quads.len(), frame.triangles.len());
     let mut types = vec![CellType::Hexahedron; frame.hexes.len()];
-    types.resize(frame.cell_count(), CellType::Quad);
+    types.resize(frame.hexes.len() + frame.quads.len(), CellType::Quad);
+    types.resize(frame.cell_count(), CellType::Triangle);
     let vtk = Vtk {
         version: Version::new_xml(1, 0),
         title: String::new(),
@@ -235,6 +243,19 @@ pub fn write_vtu(path: &Path, frame: &Frame) -> Result<()> {
     let text = with_component_names(text, "PointData", &frame.point_data);
     let text = with_component_names(text, "CellData", &frame.cell_data);
     super::write_atomic(path, text.as_bytes())
+}
+
+/// The end offsets of `nhex` 8-node, then `nquad` 4-node, then `ntri` 3-node cells.
+fn cell_offsets(nhex: usize, nquad: usize, ntri: usize) -> Vec<u64> {
+    let sizes = (std::iter::repeat_n(8u64, nhex))
+        .chain(std::iter::repeat_n(4, nquad))
+        .chain(std::iter::repeat_n(3, ntri));
+    sizes
+        .scan(0u64, |end, n| {
+            *end += n;
+            Some(*end)
+        })
+        .collect()
 }
 
 /// Adds `ComponentName{i}="..."` to the `<DataArray Name="...">` tag of every field of
@@ -339,22 +360,28 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
     let points: Vec<[f64; 3]> = coords.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
 
     let types = piece.cells.types.clone();
-    if let Some(t) = types
-        .iter()
-        .find(|&&t| t != CellType::Hexahedron && t != CellType::Quad)
-    {
+    let rank = |t: &CellType| match t {
+        CellType::Hexahedron => Some(0),
+        CellType::Quad => Some(1),
+        CellType::Triangle => Some(2),
+        _ => None,
+    };
+    if let Some(t) = types.iter().find(|t| rank(t).is_none()) {
         return Err(bad(format!(
-            "cell type {t:?} found, only hexahedra and quadrilaterals are supported"
+            "cell type {t:?} found, only hexahedra, quadrilaterals and triangles are supported"
         )));
     }
-    let nhex = types
-        .iter()
-        .take_while(|&&t| t == CellType::Hexahedron)
-        .count();
-    if types[nhex..].iter().any(|&t| t != CellType::Quad) {
-        return Err(bad("hexahedra after quadrilaterals".into()));
+    if types.windows(2).any(|w| rank(&w[0]) > rank(&w[1])) {
+        return Err(bad(
+            "cells not in the order hexahedra, quadrilaterals, triangles".into(),
+        ));
     }
-    let nquad = types.len() - nhex;
+    let count = |t: CellType| types.iter().filter(|&&c| c == t).count();
+    let (nhex, nquad, ntri) = (
+        count(CellType::Hexahedron),
+        count(CellType::Quad),
+        count(CellType::Triangle),
+    );
     let (connectivity, offsets) = match piece.cells.cell_verts {
         VertexNumbers::XML {
             connectivity,
@@ -367,14 +394,12 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
         Some(0) => &offsets[1..],
         _ => &offsets,
     };
-    let hex_end = 8 * nhex as u64;
-    let expected_offsets: Vec<u64> = (1..=nhex as u64)
-        .map(|i| 8 * i)
-        .chain((1..=nquad as u64).map(|i| hex_end + 4 * i))
-        .collect();
-    if offsets != expected_offsets.as_slice() || connectivity.len() != 8 * nhex + 4 * nquad {
+    let expected_offsets = cell_offsets(nhex, nquad, ntri);
+    if offsets != expected_offsets.as_slice()
+        || connectivity.len() != 8 * nhex + 4 * nquad + 3 * ntri
+    {
         return Err(bad(
-            "cell offsets are not those of 8-node and 4-node cells".into()
+            "cell offsets are not those of 8-node, 4-node and 3-node cells".into(),
         ));
     }
     let index = |n: u64| {
@@ -383,21 +408,18 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
             .filter(|&n| n < points.len())
             .ok_or_else(|| bad(format!("node index {n} out of range")))
     };
-    let (hex_nodes, quad_nodes) = connectivity.split_at(8 * nhex);
-    let hexes = hex_nodes
-        .chunks_exact(8)
-        .map(|c| {
-            let mut hex = [0usize; 8];
-            for (h, &n) in hex.iter_mut().zip(c) {
-                *h = index(n)?;
-            }
-            Ok(hex)
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let quads = quad_nodes
-        .chunks_exact(4)
-        .map(|c| Ok([index(c[0])?, index(c[1])?, index(c[2])?, index(c[3])?]))
-        .collect::<Result<Vec<_>>>()?;
+    let cells = |nodes: &[u64]| -> Result<Vec<usize>> { nodes.iter().map(|&n| index(n)).collect() };
+    let (hex_nodes, rest) = connectivity.split_at(8 * nhex);
+    let (quad_nodes, tri_nodes) = rest.split_at(4 * nquad);
+    let hexes = (hex_nodes.chunks_exact(8))
+        .map(|c| Ok(cells(c)?.try_into().expect("8 nodes")))
+        .collect::<Result<Vec<[usize; 8]>>>()?;
+    let quads = (quad_nodes.chunks_exact(4))
+        .map(|c| Ok(cells(c)?.try_into().expect("4 nodes")))
+        .collect::<Result<Vec<[usize; 4]>>>()?;
+    let triangles = (tri_nodes.chunks_exact(3))
+        .map(|c| Ok(cells(c)?.try_into().expect("3 nodes")))
+        .collect::<Result<Vec<[usize; 3]>>>()?;
     let text = std::str::from_utf8(&bytes).map_err(|_| bad("file is not UTF-8".into()))?;
     let point_names =
         read_component_names(text, "PointData").map_err(|e| bad(format!("bad XML: {e}")))?;
@@ -434,6 +456,7 @@ pub fn read_vtu(path: &Path) -> Result<Frame> {
         points,
         hexes,
         quads,
+        triangles,
     };
     frame
         .validate()
@@ -493,6 +516,7 @@ mod tests {
             points,
             hexes: vec![hex(0), hex(1)],
             quads: Vec::new(),
+            triangles: Vec::new(),
             point_data: vec![
                 Field::scalar("temperature", temperature),
                 Field::vector("displacement", &displacement),
@@ -545,7 +569,7 @@ mod tests {
     /// Component names are on the right arrays (a point and a cell field may share a name),
     /// and quadrilaterals round-trip after the hexahedra.
     #[test]
-    fn vtu_component_names_and_quads_round_trip() {
+    fn vtu_component_names_quads_and_triangles_round_trip() {
         let dir = temp_dir("vtu-names");
         let path = dir.join("named.vtu");
         let mut frame = two_hex_frame();
@@ -554,10 +578,11 @@ mod tests {
                 .named_components(&["a", "b&c", "d"]),
         );
         frame.quads = vec![[0, 1, 7, 6], [1, 2, 8, 7]];
+        frame.triangles = vec![[3, 4, 10], [4, 5, 11], [9, 10, 11]];
         frame.cell_data = (frame.cell_data.into_iter())
             .map(|mut f| {
                 let per = f.components;
-                let extra: Vec<f64> = (0..2 * per).map(|i| i as f64).collect();
+                let extra: Vec<f64> = (0..5 * per).map(|i| i as f64).collect();
                 f.values.extend(extra);
                 f
             })
@@ -574,7 +599,7 @@ mod tests {
             SYMMETRIC_TENSOR_COMPONENTS
         );
         assert_eq!(back.point_data[2].component_names, ["a", "b&c", "d"]);
-        assert_eq!(back.quads.len(), 2);
+        assert_eq!((back.quads.len(), back.triangles.len()), (2, 3));
         // vtkio's own reader still accepts the tags with the extra attributes.
         assert!(Vtk::import(&path).is_ok());
 

@@ -149,7 +149,8 @@ fn contact_nodes(s: &mut ScriptSim, name: &str) -> ScriptResult<Array> {
         .collect())
 }
 
-/// A node's history against a tool: one map per converged increment.
+/// A node's history against a tool: one record (src/script/record.rs) per converged
+/// increment, read like a map of `increment, time, work, mu, status`.
 fn node_history(s: &mut ScriptSim, name: &str, node: i64) -> ScriptResult<Array> {
     let mut st = s.borrow_mut();
     let sim = st.simulation()?;
@@ -177,7 +178,7 @@ fn node_history(s: &mut ScriptSim, name: &str, node: i64) -> ScriptResult<Array>
                 "status".into(),
                 Dynamic::from(STATUS[status as usize].to_string()),
             );
-            Dynamic::from(m)
+            Dynamic::from(super::record::Record::new(m))
         })
         .collect())
 }

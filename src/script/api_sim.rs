@@ -1178,9 +1178,11 @@ fn register_queries(engine: &mut Engine) {
         st.sim
             .as_ref()
             .map(|sim| {
+                // Records, not maps: an array of maps stops at Rhai's map-size limit
+                // (src/script/record.rs).
                 sim.history
                     .iter()
-                    .map(|r| Dynamic::from(report_map(r, &names)))
+                    .map(|r| Dynamic::from(super::record::Record::new(report_map(r, &names))))
                     .collect()
             })
             .unwrap_or_default()

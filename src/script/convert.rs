@@ -119,7 +119,10 @@ pub fn to_json(v: &Dynamic, at: &str, purpose: JsonUse) -> ScriptResult<serde_js
             .map(|(i, x)| to_json(x, &format!("{at}[{i}]"), purpose))
             .collect::<ScriptResult<Vec<_>>>()
             .map(Value::Array)
-    } else if let Some(m) = v.clone().try_cast::<rhai::Map>() {
+    } else if let Some(m) = (v.clone().try_cast::<rhai::Map>()).or_else(|| {
+        // A record of sim.history() / sim.node_history() is written as its map.
+        (v.read_lock::<super::record::Record>()).map(|r| r.map().clone())
+    }) {
         let mut out = serde_json::Map::new();
         for (k, x) in &m {
             out.insert(k.to_string(), to_json(x, &format!("{at}.{k}"), purpose)?);

@@ -19,6 +19,7 @@ mod api_strokes;
 mod api_tools;
 mod convert;
 pub mod limits;
+pub(crate) mod record;
 pub mod repl;
 mod settings;
 mod stdlib;
@@ -173,6 +174,7 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     api_mesh_map::register(&mut engine);
     api_shell::register(&mut engine);
     api_numbers::register(&mut engine);
+    record::register(&mut engine);
     register_checks(&mut engine);
     engine
 }

@@ -28,6 +28,8 @@ pub(super) struct FrameKnobs {
     model_fraction: f64,
     /// The forming limit curve and zone thresholds (`flc`, `flc_safety_margin`, ...).
     pub(super) formability: FormabilityOptions,
+    /// `trim_tolerance`: chord tolerance of trimmed tools' drawn trims (`None`: relative).
+    trim_tolerance: Option<f64>,
 }
 
 impl Default for FrameKnobs {
@@ -39,6 +41,7 @@ impl Default for FrameKnobs {
             units: Units::default(),
             model_fraction: 1.0,
             formability: FormabilityOptions::default(),
+            trim_tolerance: None,
         }
     }
 }
@@ -53,6 +56,7 @@ impl FrameKnobs {
             units: self.units.clone(),
             model_fraction: self.model_fraction,
             formability: self.formability.clone(),
+            trim_tolerance: self.trim_tolerance,
         }
     }
 }
@@ -156,6 +160,18 @@ pub(super) const SETTINGS: &[Setting] = &[
             ));
         }
         k.frames.model_fraction = f;
+        Ok(())
+    }),
+    setting("trim_tolerance", "0.05", |_, k, v| {
+        let tol = v.number()?;
+        if !(tol > 0.0 && tol.is_finite()) {
+            return fail(Error::input(
+                v.key,
+                tol,
+                "must be a positive length (the largest distance of a drawn trim from the exact one)",
+            ));
+        }
+        k.frames.trim_tolerance = Some(tol);
         Ok(())
     }),
     // Formability: the forming limit curve and the zone thresholds.

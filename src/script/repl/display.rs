@@ -54,6 +54,9 @@ pub fn value(v: &Dynamic) -> String {
     } else if let Some(n) = v.read_lock::<crate::script::api_contact::ContactNode>() {
         // A contact-node record shows as the map it reads like.
         value(&Dynamic::from(n.to_map()))
+    } else if let Some(r) = v.read_lock::<crate::script::record::Record>() {
+        // So does a record of sim.history() or sim.node_history().
+        value(&Dynamic::from(r.map().clone()))
     } else {
         v.to_string()
     }

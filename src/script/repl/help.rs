@@ -25,7 +25,7 @@ settings keys and tool names. Useful calls on a simulation `sim`:
   sim.node_history(\"punch\", 12)   that node's work, mu and status over the increments
   sim.displacement(node)          a node's displacement
   sim.write_frame()               write a VTK frame now
-  sim.history()                   one map per converged increment
+  sim.history()                   one report per converged increment (r.time, r.iterations, ...)
   sim.rollback()                  undo the last converged increment (sim.rollback(n): n of them)
   sim.settings(#{...})            change stepping settings (step_control, dt_max, ...) and step on
   sim.checkpoint(\"name.json\")     save the committed state below the output folder

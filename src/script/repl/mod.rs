@@ -181,12 +181,16 @@ pub fn outcome_line(
 ) -> String {
     match result {
         Ok(v) if v.is_unit() => String::new(),
-        Ok(v) => match v.read_lock::<rhai::Map>() {
-            Some(m) if display::is_report(&m) => {
-                display::report_line(&m, &host.simulations.tool_positions())
+        Ok(v) => {
+            // An increment report: sim.step()'s map, or a record of sim.history().
+            let report = (v.read_lock::<rhai::Map>().map(|m| m.clone()))
+                .or_else(|| (v.read_lock::<super::record::Record>()).map(|r| r.map().clone()))
+                .filter(display::is_report);
+            match report {
+                Some(m) => display::report_line(&m, &host.simulations.tool_positions()),
+                None => display::value(v),
             }
-            _ => display::value(v),
-        },
+        }
         Err(_) if host.interrupt.is_raised() => {
             host.interrupt.clear();
             let times: Vec<String> = host
