@@ -12,6 +12,9 @@
 //! matrices and end points carry ten digits of numbers of size ~5 (~1e-9 relative), and
 //! the NURBS forms are exact, so anything above that is a wrong surface.
 
+mod common;
+
+use common::exact_surfaces::{cone, cylinder, face_normal, plane, sphere, tube, Exact, Frame};
 use tribo::cad::iges::faces_from_iges;
 use tribo::cad::{choose_faces, tool_surface, Face, Facing, ImportOptions};
 use tribo::geometry::{RigidSurface, Vec3};
@@ -25,84 +28,25 @@ fn faces(name: &str) -> Vec<Face> {
     faces_from_iges(name, &text(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
-struct Frame {
-    o: Vec3,
-    x: Vec3,
-    y: Vec3,
-    z: Vec3,
-}
-
+/// The generator's frame.
 fn frame() -> Frame {
-    let z = Vec3::new(0.6, 0.0, 0.8);
-    let x = Vec3::y();
-    Frame {
-        o: Vec3::new(1.0, 2.0, 3.0),
-        x,
-        y: z.cross(&x),
-        z,
-    }
-}
-
-/// Distance of `p` to the exact surface and the surface's documented normal there.
-type Exact = Box<dyn Fn(Vec3) -> (f64, Vec3)>;
-
-/// Axial coordinate `h`, radius `rho` and unit radial direction of `p` in the frame.
-fn cylindrical(f: &Frame, p: Vec3) -> (f64, f64, Vec3) {
-    let d = p - f.o;
-    let h = d.dot(&f.z);
-    let radial = d - f.z * h;
-    (h, radial.norm(), radial.normalize())
-}
-
-/// A tube of radius `r` about the circle of radius `big`: distance, normal out of the tube.
-fn tube(big: f64, r: f64) -> Exact {
-    let f = frame();
-    Box::new(move |p| {
-        let (h, rho, e) = cylindrical(&f, p);
-        let to = e * (rho - big) + f.z * h;
-        (to.norm() - r, to.normalize())
-    })
+    Frame::new(Vec3::new(1.0, 2.0, 3.0), Vec3::y(), Vec3::new(0.6, 0.0, 0.8))
 }
 
 fn exact(kind: &str) -> Exact {
     let f = frame();
     match kind {
-        "plane" => Box::new(move |p| ((p - f.o).dot(&f.z), f.z)),
-        "cylinder" => Box::new(move |p| {
-            let (_, rho, e) = cylindrical(&f, p);
-            (rho - 4.0, e)
-        }),
-        "cone" => Box::new(move |p| {
-            let (h, rho, e) = cylindrical(&f, p);
-            let a = 30f64.to_radians();
-            (
-                (rho - 3.0 - h * a.tan()) * a.cos(),
-                e * a.cos() - f.z * a.sin(),
-            )
-        }),
-        "sphere" => Box::new(move |p| ((p - f.o).norm() - 5.0, (p - f.o).normalize())),
-        "torus" => tube(5.0, 2.0),
-        "spindle" => tube(2.0, 5.0),
+        "plane" => plane(f),
+        "cylinder" => cylinder(f, 4.0),
+        "cone" => cone(f, 3.0, 30f64.to_radians()),
+        "sphere" => sphere(f, 5.0),
+        "torus" => tube(f, 5.0, 2.0),
+        "spindle" => tube(f, 2.0, 5.0),
         _ => unreachable!(),
     }
 }
 
 const KINDS: [&str; 6] = ["plane", "cylinder", "cone", "sphere", "torus", "spindle"];
-
-/// `S_u x S_v` by central differences (step 1e-6 of the domain: error ~1e-12 relative),
-/// reversed if the face is.
-fn face_normal(face: &Face, u: f64, v: f64) -> Vec3 {
-    let [du, dv] = face.surface.domain();
-    let (hu, hv) = (1e-6 * (du[1] - du[0]), 1e-6 * (dv[1] - dv[0]));
-    let su = face.surface.point(u + hu, v) - face.surface.point(u - hu, v);
-    let sv = face.surface.point(u, v + hv) - face.surface.point(u, v - hv);
-    let n = su.cross(&sv).normalize();
-    if face.flip {
-        -n
-    } else {
-        n
-    }
-}
 
 /// Every face's surface, sampled on a 41 x 41 grid of its parameter box, lies on the
 /// exact surface to 1e-9 mm, and its normal is the documented one (a 510 no shell lists

@@ -8,6 +8,9 @@
 //! coordinates of size ~10 (1e-12 mm), and the NURBS forms are exact, so anything above
 //! rounding is a wrong surface.
 
+mod common;
+
+use common::exact_surfaces::{cone, cylinder, face_normal, plane, sphere, tube, Exact, Frame};
 use tribo::cad::step::faces_from_step;
 use tribo::cad::{tool_surface, Face, ImportOptions};
 use tribo::geometry::{RigidSurface, Vec3};
@@ -18,73 +21,27 @@ fn faces(name: &str) -> Vec<Face> {
     faces_from_step(name, &text).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
-struct Frame {
-    o: Vec3,
-    x: Vec3,
-    y: Vec3,
-    z: Vec3,
-}
-
+/// The generator's frame.
 fn frame() -> Frame {
     let z = Vec3::new(0.2, -0.3, 1.0).normalize();
     let v = Vec3::new(1.0, 0.1, 0.04);
-    let x = (v - z * v.dot(&z)).normalize();
-    Frame {
-        o: Vec3::new(1.0, 2.0, 3.0),
-        x,
-        y: z.cross(&x),
-        z,
-    }
-}
-
-/// Distance of `p` to the exact surface and the surface's documented normal there.
-type Exact = Box<dyn Fn(Vec3) -> (f64, Vec3)>;
-
-/// Axial coordinate `h`, radius `rho` and unit radial direction of `p` in the frame.
-fn cylindrical(f: &Frame, p: Vec3) -> (f64, f64, Vec3) {
-    let d = p - f.o;
-    let h = d.dot(&f.z);
-    let radial = d - f.z * h;
-    (h, radial.norm(), radial.normalize())
-}
-
-/// A tube of radius `r` about the circle of radius `big` (torus, spindle torus).
-fn tube(big: f64, r: f64) -> Exact {
-    let f = frame();
-    Box::new(move |p| {
-        let (h, rho, e) = cylindrical(&f, p);
-        let to = e * (rho - big) + f.z * h;
-        (to.norm() - r, to.normalize())
-    })
+    Frame::new(Vec3::new(1.0, 2.0, 3.0), (v - z * v.dot(&z)).normalize(), z)
 }
 
 fn exact(kind: &str) -> Exact {
     let f = frame();
     match kind {
-        "plane" => Box::new(move |p| ((p - f.o).dot(&f.z), f.z)),
-        "cylinder" | "band" => Box::new(move |p| {
-            let (_, rho, e) = cylindrical(&f, p);
-            (rho - 4.0, e)
-        }),
-        "offset" => Box::new(move |p| {
-            let (_, rho, e) = cylindrical(&f, p);
-            (rho - 5.5, e)
-        }),
-        "cone" => Box::new(move |p| {
-            let (h, rho, e) = cylindrical(&f, p);
-            let a: f64 = 0.4;
-            (
-                (rho - 3.0 - h * a.tan()) * a.cos(),
-                e * a.cos() - f.z * a.sin(),
-            )
-        }),
-        "sphere" => Box::new(move |p| ((p - f.o).norm() - 5.0, (p - f.o).normalize())),
-        "torus" => tube(5.0, 2.0),
-        "spindle" => tube(2.0, 5.0),
+        "plane" => plane(f),
+        "cylinder" | "band" => cylinder(f, 4.0),
+        "offset" => cylinder(f, 5.5),
+        "cone" => cone(f, 3.0, 0.4),
+        "sphere" => sphere(f, 5.0),
+        "torus" => tube(f, 5.0, 2.0),
+        "spindle" => tube(f, 2.0, 5.0),
         // The ellipse (semi-axes 1.5 along the radius, 1 along the axis) about the circle
         // of radius 4, turned: distance to first order |F| / |grad F|.
         "revolution" => Box::new(move |p| {
-            let (h, rho, e) = cylindrical(&f, p);
+            let (h, rho, e) = f.cylindrical(p);
             let value = ((rho - 4.0) / 1.5).powi(2) + h * h - 1.0;
             let grad = e * (2.0 * (rho - 4.0) / 2.25) + f.z * (2.0 * h);
             (value / grad.norm(), grad.normalize())
@@ -114,21 +71,6 @@ const KINDS: [&str; 10] = [
     "extrusion",
     "offset",
 ];
-
-/// `S_u x S_v` by central differences (step 1e-6 of the domain: error ~1e-12 relative),
-/// reversed if the face is.
-fn face_normal(face: &Face, u: f64, v: f64) -> Vec3 {
-    let [du, dv] = face.surface.domain();
-    let (hu, hv) = (1e-6 * (du[1] - du[0]), 1e-6 * (dv[1] - dv[0]));
-    let su = face.surface.point(u + hu, v) - face.surface.point(u - hu, v);
-    let sv = face.surface.point(u, v + hv) - face.surface.point(u, v - hv);
-    let n = su.cross(&sv).normalize();
-    if face.flip {
-        -n
-    } else {
-        n
-    }
-}
 
 /// Every face's surface, sampled on a 41 x 41 grid of its parameter box, lies on the
 /// exact surface to 1e-9 mm, and its outward normal is the documented one (OpenCascade

@@ -1,6 +1,7 @@
 //! Shared set-up for the integration tests.
 #![allow(dead_code)]
 
+pub mod exact_surfaces;
 pub mod pty;
 
 /// A test's output folder in the system's temporary folder: emptied when made, removed when
