@@ -5,7 +5,7 @@
 //! `o` and orthonormal axes, z the axis of revolution or the plane's normal.
 
 use tribo::cad::Face;
-use tribo::geometry::{RigidSurface, Vec3};
+use tribo::geometry::Vec3;
 
 pub struct Frame {
     pub o: Vec3,
