@@ -17,7 +17,7 @@ mod common;
 use common::exact_surfaces::{cone, cylinder, face_normal, plane, sphere, tube, Exact, Frame};
 use tribo::cad::iges::faces_from_iges;
 use tribo::cad::{choose_faces, tool_surface, Face, Facing, ImportOptions};
-use tribo::geometry::Vec3;
+use tribo::geometry::{RigidSurface, Vec3};
 
 fn text(name: &str) -> String {
     let path = format!("{}/tests/data/cad/{name}", env!("CARGO_MANIFEST_DIR"));

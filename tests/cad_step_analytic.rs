@@ -13,7 +13,7 @@ mod common;
 use common::exact_surfaces::{cone, cylinder, face_normal, plane, sphere, tube, Exact, Frame};
 use tribo::cad::step::faces_from_step;
 use tribo::cad::{tool_surface, Face, ImportOptions};
-use tribo::geometry::Vec3;
+use tribo::geometry::{RigidSurface, Vec3};
 
 fn faces(name: &str) -> Vec<Face> {
     let path = format!("{}/tests/data/cad/{name}", env!("CARGO_MANIFEST_DIR"));
