@@ -558,3 +558,23 @@ fn geometry_updates_refuse_extrapolation_and_need_a_wear_law() {
         "{err}"
     );
 }
+
+/// The script key: `update_geometry_every` runs stroke 2 of the block over the flat floor
+/// (tests/scripts/strokes_block.rhai) on the worn floor; a value below 1 is refused,
+/// naming the key and the value.
+#[test]
+fn the_script_key_update_geometry_every_is_read_and_checked() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = std::fs::read_to_string(root.join("tests/scripts/strokes_block.rhai")).unwrap();
+    let with = |every: &str| {
+        base.replace(
+            "sim.strokes(2);",
+            &format!("sim.strokes(2, #{{ update_geometry_every: {every} }});"),
+        )
+    };
+    let (code, err) = common::run_script("strokes_geom_ok", "worn", &with("1"), &[]);
+    assert_eq!(code, 0, "{err}");
+    let (code, err) = common::run_script("strokes_geom_bad", "worn", &with("0"), &[]);
+    assert_ne!(code, 0);
+    assert!(err.contains("update_geometry_every") && err.contains('0'), "{err}");
+}
