@@ -576,5 +576,8 @@ fn the_script_key_update_geometry_every_is_read_and_checked() {
     assert_eq!(code, 0, "{err}");
     let (code, err) = common::run_script("strokes_geom_bad", "worn", &with("0"), &[]);
     assert_ne!(code, 0);
-    assert!(err.contains("update_geometry_every") && err.contains('0'), "{err}");
+    assert!(
+        err.contains("update_geometry_every") && err.contains('0'),
+        "{err}"
+    );
 }
