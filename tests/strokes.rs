@@ -16,6 +16,8 @@
 //!   copy); its tangential forces grow. A restart inside stroke 2 ends bit for bit as the
 //!   uninterrupted run.
 //! - Refusals: extrapolating with a tool-state law, a tool-state law without fields.
+//! - Geometry updated by the wear (`update_geometry_every`): stroke 2 on the roller worn by
+//!   stroke 1 (contact nodes at the worn surface to 1e-10), its restart, its refusals.
 
 mod common;
 
@@ -393,4 +395,189 @@ fn a_script_of_two_strokes_reports_them() {
         })
         .collect();
     assert_eq!(times, ["0", "0.5", "1", "1.5", "2"], "{pvd}");
+}
+
+/// The roller of [`roller`] wearing fast (k / H = 1e-5 /MPa, so that one stroke wears
+/// micrometres to hundredths of a millimetre, far above the 1e-10 the test reads), with
+/// its geometry updated by its wear after every `every` strokes.
+fn wearing_roller(strokes: Strokes) -> Model {
+    let mut model = roller(coulomb(), strokes);
+    model.contacts[0].tool.fields = Some(FieldSpec {
+        wear: WearLaw::archard(1.0, 1e5).unwrap(),
+        cell: None,
+    });
+    model
+}
+
+/// Per candidate node in contact: (its signed distance to the EXACT roller, the wear depth
+/// of the cell under its foot as applied to the geometry; 0 when not worn).
+fn contact_gaps(sim: &Simulation) -> Vec<(f64, f64)> {
+    let contact = &sim.model.contacts[0];
+    let pose = sim.tool_pose(0);
+    let fields = sim.tool_fields(0).unwrap();
+    let applied = sim.applied_tool_wear(0);
+    (contact.candidates.iter().zip(sim.contact_states(0)))
+        .filter(|(_, s)| s.status.is_active())
+        .map(|(&n, s)| {
+            let x = sim.model.mesh.nodes[n] + sim.displacement(n);
+            let exact = tribo::tool::project_posed(
+                contact.tool.surface.as_ref(),
+                &pose,
+                &x,
+                s.hint.as_ref(),
+            )
+            .unwrap();
+            let h = applied.map_or(0.0, |a| {
+                let hint = exact.hint;
+                a[fields.offsets[hint.patch] + fields.grids[hint.patch].cell_of([hint.u, hint.v])]
+            });
+            (exact.gap, h)
+        })
+        .collect()
+}
+
+/// Issue 53, geometry updated by the wear (`update_geometry_every: 1`): stroke 1 runs on
+/// the exact roller (bit for bit the run without the option), stroke 2 on the roller worn by
+/// stroke 1's wear: every node in contact at every increment of stroke 2 lies at the worn
+/// surface, its distance to the exact roller minus the wear depth of the cell under it, to
+/// 1e-10 (contact and force tolerances of the roller drag bound the gap of a converged
+/// contact node by far less). Newton keeps its iteration counts (the per-cell constant
+/// offset leaves the consistent Jacobian exact: no dh/du term exists).
+#[test]
+fn stroke_two_runs_on_the_roller_worn_by_stroke_one() {
+    let plain = Strokes::new(2, 2).unwrap();
+    let mut exact = Simulation::new(wearing_roller(plain)).unwrap();
+    let mut worn =
+        Simulation::new(wearing_roller(plain.updating_geometry_every(1).unwrap())).unwrap();
+    assert_eq!(run_stroke(&mut worn), run_stroke(&mut exact));
+    assert!(worn.applied_tool_wear(0).is_none());
+    let wear_1 = worn.tool_fields(0).unwrap().values.wear.clone();
+    println!(
+        "stroke 1 wears the roller by up to {:e}",
+        wear_1.iter().fold(0.0f64, |m, x| m.max(*x))
+    );
+    let (mut checked, mut largest, mut iterations) = (0, 0.0f64, [0, 0]);
+    for (k, sim) in [&mut exact, &mut worn].into_iter().enumerate() {
+        loop {
+            let r = sim.step().unwrap();
+            iterations[k] += r.iterations;
+            for (d, h) in contact_gaps(sim) {
+                assert!(
+                    (d + h).abs() <= 1e-10,
+                    "stroke 2, t = {}: exact gap {d:e}, wear {h:e}",
+                    r.time
+                );
+                checked += 1;
+                largest = largest.max(h);
+            }
+            if sim.stroke_done() {
+                break;
+            }
+        }
+    }
+    assert_eq!(worn.applied_tool_wear(0), Some(&wear_1[..]));
+    println!("{checked} contact nodes checked, largest wear depth {largest:e}; Newton iterations of stroke 2 exact/worn {iterations:?}");
+    assert!(
+        largest > 1e-5,
+        "the wear is far above the tolerance: {largest:e}"
+    );
+    assert!(iterations[1] <= iterations[0] + 2, "{iterations:?}");
+}
+
+/// A restart inside stroke 2 of a run updating the geometry after stroke 1: the checkpoint
+/// carries the applied wear (`state.tool_wear_applied`), the restart ends bit for bit as
+/// the uninterrupted run, and a script without the update refuses the checkpoint.
+#[test]
+fn a_restart_on_the_worn_roller_continues_bit_for_bit() {
+    let strokes = Strokes::new(2, 2)
+        .unwrap()
+        .updating_geometry_every(1)
+        .unwrap();
+    let mut whole = Simulation::new(wearing_roller(strokes)).unwrap();
+    whole.run(|_, _| Ok(())).unwrap();
+    let mut first = Simulation::new(wearing_roller(strokes)).unwrap();
+    for _ in 0..17 {
+        first.step().unwrap();
+    }
+    assert_eq!(first.stroke(), 2);
+    let json = Checkpoint::of(&first, Vec::new()).to_json().unwrap();
+    let mut second = Simulation::new(wearing_roller(strokes)).unwrap();
+    Checkpoint::from_json(&json, "test")
+        .unwrap()
+        .restore(&mut second)
+        .unwrap();
+    assert_eq!(second.applied_tool_wear(0), first.applied_tool_wear(0));
+    second.run(|_, _| Ok(())).unwrap();
+    assert_eq!(
+        whole.tool_fields(0).unwrap().values,
+        second.tool_fields(0).unwrap().values
+    );
+    let forces = |s: &Simulation| {
+        s.history
+            .iter()
+            .map(|r| r.tool_forces[0])
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(forces(&whole), forces(&second));
+    let mut unworn = Simulation::new(wearing_roller(Strokes::new(2, 2).unwrap())).unwrap();
+    let err = Checkpoint::from_json(&json, "test")
+        .unwrap()
+        .restore(&mut unworn)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("worn") && err.contains("update_geometry_every"),
+        "{err}"
+    );
+}
+
+#[test]
+fn geometry_updates_refuse_extrapolation_and_need_a_wear_law() {
+    let strokes = Strokes::new(10, 2)
+        .unwrap()
+        .updating_geometry_every(1)
+        .unwrap();
+    let err = Simulation::new(wearing_roller(strokes))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("extrapolated") && err.contains("update_geometry_every"),
+        "{err}"
+    );
+    let mut model = wearing_roller(
+        Strokes::new(2, 2)
+            .unwrap()
+            .updating_geometry_every(1)
+            .unwrap(),
+    );
+    model.contacts[0].tool.fields = None;
+    let err = Simulation::new(model).err().unwrap().to_string();
+    assert!(
+        err.contains("update_geometry_every") && err.contains("wear law"),
+        "{err}"
+    );
+}
+
+/// The script key: `update_geometry_every` runs stroke 2 of the block over the flat floor
+/// (tests/scripts/strokes_block.rhai) on the worn floor; a value below 1 is refused,
+/// naming the key and the value.
+#[test]
+fn the_script_key_update_geometry_every_is_read_and_checked() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = std::fs::read_to_string(root.join("tests/scripts/strokes_block.rhai")).unwrap();
+    let with = |every: &str| {
+        base.replace(
+            "sim.strokes(2);",
+            &format!("sim.strokes(2, #{{ update_geometry_every: {every} }});"),
+        )
+    };
+    let (code, err) = common::run_script("strokes_geom_ok", "worn", &with("1"), &[]);
+    assert_eq!(code, 0, "{err}");
+    let (code, err) = common::run_script("strokes_geom_bad", "worn", &with("0"), &[]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("update_geometry_every") && err.contains('0'),
+        "{err}"
+    );
 }

@@ -6,6 +6,9 @@
 //!   `sim.finished()`) runs them all.
 //! - `sim.strokes(n, #{ simulate: m })`: simulate the first m strokes and extrapolate the
 //!   tools' fields linearly to n (refused when a friction law reads the tool's state).
+//! - `sim.strokes(n, #{ update_geometry_every: k })`: after every k strokes the tools'
+//!   surfaces are offset along their normals by the wear depth accumulated so far (each
+//!   tool with a wear law; `tool::worn`), from stroke k + 1 on. Keys may be combined.
 //! - `sim.stroke()`: the stroke the committed state belongs to, from 1.
 
 use super::api_sim::ScriptSim;
@@ -15,12 +18,13 @@ use rhai::{Engine, Map};
 
 pub fn register(engine: &mut Engine) {
     engine.register_fn("strokes", |s: &mut ScriptSim, n: i64| -> ScriptResult<()> {
-        set_strokes(s, n, n)
+        set_strokes(s, n, n, None)
     });
     engine.register_fn(
         "strokes",
         |s: &mut ScriptSim, n: i64, options: Map| -> ScriptResult<()> {
             let mut simulate = n;
+            let mut every = None;
             for (key, value) in &options {
                 match key.as_str() {
                     "simulate" => {
@@ -30,14 +34,21 @@ pub fn register(engine: &mut Engine) {
                             ))
                         })?
                     }
+                    "update_geometry_every" => {
+                        every = Some(value.as_int().or_else(|_| {
+                            runtime_error(format!(
+                                "sim.strokes: update_geometry_every must be an integer number of strokes, not {value}"
+                            ))
+                        })?)
+                    }
                     other => {
                         return runtime_error(format!(
-                            "sim.strokes: unknown option '{other}' (the only one is simulate)"
+                            "sim.strokes: unknown option '{other}' (the options are simulate and update_geometry_every)"
                         ))
                     }
                 }
             }
-            set_strokes(s, n, simulate)
+            set_strokes(s, n, simulate, every)
         },
     );
     engine.register_fn("stroke", |s: &mut ScriptSim| -> ScriptResult<i64> {
@@ -47,8 +58,16 @@ pub fn register(engine: &mut Engine) {
 }
 
 /// Sets the strokes on the model (before the simulation starts).
-fn set_strokes(s: &mut ScriptSim, n: i64, simulate: i64) -> ScriptResult<()> {
-    let strokes = lift(Strokes::new(n, simulate))?;
+fn set_strokes(
+    s: &mut ScriptSim,
+    n: i64,
+    simulate: i64,
+    update_geometry_every: Option<i64>,
+) -> ScriptResult<()> {
+    let mut strokes = lift(Strokes::new(n, simulate))?;
+    if let Some(k) = update_geometry_every {
+        strokes = lift(strokes.updating_geometry_every(k))?;
+    }
     let mut st = s.borrow_mut();
     match st.model_mut() {
         Ok(model) => {

@@ -9,7 +9,9 @@ pub use pose::{project_posed, Pose};
 pub use schedule::{ScalarSchedule, Schedule};
 pub mod rigid_tool;
 pub mod surface_fields;
+pub mod worn;
 
 pub use force_control::ForceControl;
 pub use rigid_tool::Tool;
 pub use surface_fields::{FieldSpec, ToolFields, WearLaw};
+pub use worn::WornSurface;

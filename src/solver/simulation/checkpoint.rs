@@ -69,6 +69,11 @@ pub struct SavedState {
     /// start (module `simulation::strokes`); left out when no tool's friction reads it.
     #[serde(default, skip_serializing_if = "no_frozen_work")]
     pub tool_work_frozen: Vec<Option<Vec<f64>>>,
+    /// Per tool worn by a geometry update of the strokes: the wear depth per cell its
+    /// surface is offset by (`tool::worn`), the tool's wear field as the last update before
+    /// this stroke took it; left out when no tool is worn (older checkpoints: none).
+    #[serde(default, skip_serializing_if = "no_frozen_work")]
+    pub tool_wear_applied: Vec<Option<Vec<f64>>>,
 }
 
 fn is_zero(k: &usize) -> bool {
@@ -376,8 +381,9 @@ fn check_tool_fields(
     Ok(())
 }
 
-/// The checkpoint's stroke within the script's strokes, and the frozen work of every tool
-/// whose friction reads it: present, one finite value >= 0 per cell.
+/// The checkpoint's stroke within the script's strokes, the frozen work of every tool
+/// whose friction reads it and the wear depth of every worn tool: one finite value >= 0
+/// per cell.
 fn check_strokes(sim: &Simulation, s: &SavedState) -> Result<()> {
     let simulated = sim.model.strokes.simulated;
     if s.stroke >= simulated {
@@ -396,25 +402,71 @@ fn check_strokes(sim: &Simulation, s: &SavedState) -> Result<()> {
         ) {
             continue;
         }
+        check_per_cell(
+            &contact.tool.name,
+            c,
+            "tool_work_frozen",
+            &s.tool_work_frozen,
+            fields.len(),
+        )?;
+    }
+    // Worn tools exactly when the script's strokes have updated the geometry by this one.
+    let worn = s.tool_wear_applied.iter().any(Option::is_some);
+    let updated = matches!(sim.model.strokes.update_geometry_every, Some(k) if s.stroke >= k);
+    if worn != updated {
+        return Err(Error::Input(format!(
+            "the checkpoint (stroke {}) has {} worn tool geometry, but the script's strokes (update_geometry_every {:?}) {} updated it by then",
+            s.stroke + 1,
+            if worn { "a" } else { "no" },
+            sim.model.strokes.update_geometry_every,
+            if updated { "have" } else { "have not" },
+        )));
+    }
+    for (c, contact) in sim.model.contacts.iter().enumerate() {
+        let Some(Some(_)) = s.tool_wear_applied.get(c) else {
+            continue;
+        };
         let name = &contact.tool.name;
-        let frozen = s.tool_work_frozen.get(c).and_then(Option::as_ref);
-        let Some(frozen) = frozen else {
+        let Some(fields) = sim.tool_fields(c) else {
             return Err(Error::Input(format!(
-                "tool '{name}': its friction reads the tool's work, but the checkpoint holds no state.tool_work_frozen for it (written by a script without friction_of_tool_work)"
+                "the checkpoint's state.tool_wear_applied[{c}] wears tool '{name}', but the tool has no tool-side fields (no wear law)"
             )));
         };
-        if frozen.len() != fields.len() {
-            return Err(Error::Input(format!(
-                "the checkpoint's state.tool_work_frozen[{c}] (tool '{name}') has {} values, the grid {} cells",
-                frozen.len(),
-                fields.len()
-            )));
-        }
-        if let Some(v) = frozen.iter().find(|v| !(**v >= 0.0 && v.is_finite())) {
-            return Err(Error::Input(format!(
-                "the checkpoint's state.tool_work_frozen[{c}] (tool '{name}') holds {v}, but its values are finite and >= 0 (the file was edited or is damaged)"
-            )));
-        }
+        check_per_cell(
+            name,
+            c,
+            "tool_wear_applied",
+            &s.tool_wear_applied,
+            fields.len(),
+        )?;
+    }
+    Ok(())
+}
+
+/// `state.<what>[c]` of tool `name`: present, one finite value >= 0 per cell of its grid.
+fn check_per_cell(
+    name: &str,
+    c: usize,
+    what: &str,
+    values: &[Option<Vec<f64>>],
+    cells: usize,
+) -> Result<()> {
+    let frozen = values.get(c).and_then(Option::as_ref);
+    let Some(frozen) = frozen else {
+        return Err(Error::Input(format!(
+            "tool '{name}': its friction reads the tool's work, but the checkpoint holds no state.{what} for it (written by a script without friction_of_tool_work)"
+        )));
+    };
+    if frozen.len() != cells {
+        return Err(Error::Input(format!(
+            "the checkpoint's state.{what}[{c}] (tool '{name}') has {} values, the grid {cells} cells",
+            frozen.len(),
+        )));
+    }
+    if let Some(v) = frozen.iter().find(|v| !(**v >= 0.0 && v.is_finite())) {
+        return Err(Error::Input(format!(
+            "the checkpoint's state.{what}[{c}] (tool '{name}') holds {v}, but its values are finite and >= 0 (the file was edited or is damaged)"
+        )));
     }
     Ok(())
 }

@@ -18,7 +18,7 @@ use crate::contact::{ContactNodeState, ContactStatus, FrameUpdate, FrictionInput
 use crate::geometry::Vec3;
 use crate::material::PointState;
 use crate::solver::assembly::force_control;
-use crate::solver::assembly::{DofMap, EvaluationCounts, Evaluation, PhaseTimes};
+use crate::solver::assembly::{DofMap, Evaluation, EvaluationCounts, PhaseTimes};
 use crate::solver::linear::condense::Condenser;
 use crate::solver::linear::{LinearSolver, Solver};
 use crate::solver::model::{steps, Model};
@@ -189,6 +189,10 @@ pub struct Simulation {
     /// Per tool whose friction reads the tool's work (`FrictionLaw::ToolWork`): its work
     /// per area frozen at the start of the stroke. Part of the committed state.
     pub(super) tool_work_frozen: Vec<Option<Vec<f64>>>,
+    /// Per tool: the wear depth per cell its surface is worn by (`tool::worn`), set when
+    /// a stroke starts with a geometry update (module `strokes`); `None`: the exact
+    /// surface. Part of the committed state; mirrored in `model.contacts[c].tool.worn`.
+    pub(super) tool_wear_applied: Vec<Option<Vec<f64>>>,
     /// The state `new` built, where every stroke after the first starts; kept only when
     /// several strokes are simulated.
     pub(super) initial: Option<Box<SavedState>>,
@@ -332,6 +336,7 @@ impl Simulation {
             tool_fields,
             stroke: 0,
             tool_work_frozen,
+            tool_wear_applied: vec![None; model.contacts.len()],
             initial: None,
             energy_memory: EnergyMemory {
                 support_forces: vec![0.0; 3 * dofs_nodes],
@@ -791,6 +796,7 @@ impl Simulation {
                 .collect(),
             stroke: self.stroke,
             tool_work_frozen: self.tool_work_frozen.clone(),
+            tool_wear_applied: self.tool_wear_applied.clone(),
         }
     }
 
@@ -828,6 +834,13 @@ impl Simulation {
         } else {
             self.tool_work_frozen = self.freeze_tool_work();
         }
+        // Older checkpoints have no worn geometry: the exact tools.
+        self.tool_wear_applied = if state.tool_wear_applied.len() == self.tool_wear_applied.len() {
+            state.tool_wear_applied
+        } else {
+            vec![None; self.tool_wear_applied.len()]
+        };
+        self.set_worn_tools();
     }
 
     /// The tool-side fields of tool `c`, if it accumulates them (`Tool::fields`).

@@ -21,17 +21,41 @@
 //! fixed mu is exact. Freezing over the stroke keeps a stroke from reading the work it
 //! deposits itself (the sheet's own law already follows that), so stroke 1 is the run
 //! without strokes and stroke k sees the tool as the k - 1 strokes before left it.
+//!
+//! Geometry updated by the wear (`Strokes::update_geometry_every`). When a stroke starts
+//! with an update (`Strokes::updates_geometry_at`), each tool with tool-side fields takes
+//! a copy of its wear depth field as it is then, and its surface becomes the exact surface
+//! worn by that depth (`tool::worn`: a normal offset, constant per cell, so the contact
+//! Jacobian needs no derivative of the depth) until the next update. Without updates no
+//! tool is worn and every projection is the exact one, bit for bit as before. Restart: the
+//! copy is part of the committed state and of checkpoints (`state.tool_wear_applied`); it
+//! cannot be recomputed from the checkpoint's fields, which hold the wear of the strokes
+//! after the update too, so it is stored. A restore sets the tools' worn surfaces from it.
 
 use crate::contact::FrictionLaw;
 use crate::geometry::SurfaceHint;
 use crate::solver::model::Model;
 use crate::solver::simulation::Simulation;
-use crate::tool::ToolFields;
+use crate::tool::{ToolFields, WornSurface};
 use crate::{Error, Result};
+use std::sync::Arc;
 
 /// Checks what strokes and tool-state laws need, before the run: a tool whose friction
 /// reads its state has tool-side fields; extrapolation is refused when any law does.
 pub(super) fn check(model: &Model) -> Result<()> {
+    if model.strokes.update_geometry_every.is_some() {
+        if !model.contacts.iter().any(|c| c.tool.fields.is_some()) {
+            return Err(Error::Input(
+                "sim.strokes: update_geometry_every updates the tools' geometry by their wear, but no tool accumulates wear; give a tool a wear law (tool.wear(archard(k, H)))".into(),
+            ));
+        }
+        if model.strokes.extrapolated() {
+            return Err(Error::Input(format!(
+                "the strokes cannot be extrapolated ({} simulated of {}) when the tools' geometry is updated by their wear (update_geometry_every): each stroke differs; simulate every stroke (sim.strokes({}))",
+                model.strokes.simulated, model.strokes.total, model.strokes.total
+            )));
+        }
+    }
     for contact in &model.contacts {
         let name = &contact.tool.name;
         if let FrictionLaw::ToolWork(_) = contact.tool.friction {
@@ -121,9 +145,32 @@ impl Simulation {
         state.tool_fields = self.saved_state().tool_fields;
         state.tool_work_frozen = self.freeze_tool_work();
         state.stroke = self.stroke + 1;
+        state.tool_wear_applied = if self.model.strokes.updates_geometry_at(state.stroke) {
+            (self.tool_fields.iter())
+                .map(|f| f.as_ref().map(|f| f.fields.values.wear.clone()))
+                .collect()
+        } else {
+            self.tool_wear_applied.clone()
+        };
         self.restore_state(state);
         self.set_tool_state_mu();
         Ok(())
+    }
+
+    /// The wear depth per cell tool `c`'s surface is worn by, if it is worn.
+    pub fn applied_tool_wear(&self, c: usize) -> Option<&[f64]> {
+        self.tool_wear_applied[c].as_deref()
+    }
+
+    /// Each tool's surface worn by its applied wear depth, or exact (module doc).
+    pub(super) fn set_worn_tools(&mut self) {
+        for (c, depth) in self.tool_wear_applied.iter().enumerate() {
+            let worn = match (depth, &self.tool_fields[c]) {
+                (Some(h), Some(f)) => Some(Arc::new(WornSurface::new(&f.fields, h.clone()))),
+                _ => None,
+            };
+            self.model.contacts[c].tool.worn = worn;
+        }
     }
 
     /// mu of every node under a tool-state law, from its committed foot and the frozen work.
