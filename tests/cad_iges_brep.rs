@@ -30,7 +30,11 @@ fn faces(name: &str) -> Vec<Face> {
 
 /// The generator's frame.
 fn frame() -> Frame {
-    Frame::new(Vec3::new(1.0, 2.0, 3.0), Vec3::y(), Vec3::new(0.6, 0.0, 0.8))
+    Frame::new(
+        Vec3::new(1.0, 2.0, 3.0),
+        Vec3::y(),
+        Vec3::new(0.6, 0.0, 0.8),
+    )
 }
 
 fn exact(kind: &str) -> Exact {

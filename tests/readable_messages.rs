@@ -39,7 +39,10 @@ fn a_stop_gives_its_reason_first_and_details_below() {
         details.iter().any(|l| l.contains("checkpoints/final.json")),
         "where the state was saved: {err}"
     );
-    assert!(!err.contains("Young's modulus"), "no units note at E = 1000: {err}");
+    assert!(
+        !err.contains("Young's modulus"),
+        "no units note at E = 1000: {err}"
+    );
     // The first line carries the script's path and position before the reason (a temporary
     // folder here, some 45 characters); the one line was 455 characters before.
     for line in &lines[at..] {
@@ -68,7 +71,10 @@ fn a_first_increment_stop_with_a_modulus_in_gpa_suggests_the_units() {
             && note.contains("times 1,000"),
         "{note}"
     );
-    let metres = soft.replace("kinematics: \"small\"", "kinematics: \"small\", units: #{ length: \"m\" }");
+    let metres = soft.replace(
+        "kinematics: \"small\"",
+        "kinematics: \"small\", units: #{ length: \"m\" }",
+    );
     assert!(metres.contains("units"), "the replacement took");
     let (code, err) = common::run_script("units-note", "metres", &metres, &[]);
     assert_eq!(code, 1, "{err}");

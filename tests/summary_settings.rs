@@ -98,6 +98,7 @@ fn summaries_differ_in_exactly_the_setting_that_differs() {
         "stretch_limit",
         "wrinkle_limit",
         "checkpoint_every",
+        "trim_tolerance",
     ];
     for key in tribo::script::SETTING_KEYS {
         assert!(

@@ -183,7 +183,9 @@ fn local_jobs_one_by_one_parallel_file_and_slurm_array_agree_and_collect_charts(
     assert!(directives.contains(&"#SBATCH --mem=4096M"), "{text}");
     let commands = std::fs::read_to_string(slurm.join("commands.txt")).unwrap();
     assert!(
-        commands.lines().all(|l| l.contains(" --max-memory-mb 4096 ")),
+        commands
+            .lines()
+            .all(|l| l.contains(" --max-memory-mb 4096 ")),
         "{commands}"
     );
     assert!(text.contains("SLURM_ARRAY_TASK_ID") && text.contains("commands.txt"));
@@ -264,7 +266,11 @@ fn slurm_time_and_memory_are_settable_and_checked() {
     assert!(text.contains("\n#SBATCH --time=1-12:00:00\n"), "{text}");
     assert!(text.contains("\n#SBATCH --mem=16384M\n"), "{text}");
     let commands = std::fs::read_to_string(out.join("commands.txt")).unwrap();
-    assert_eq!(commands.matches(" --max-memory-mb 16384 ").count(), 2, "{commands}");
+    assert_eq!(
+        commands.matches(" --max-memory-mb 16384 ").count(),
+        2,
+        "{commands}"
+    );
 
     let refused = |extra: &[&str], folder: &str, said: &str| {
         let out = dir.join(folder);
@@ -277,8 +283,20 @@ fn slurm_time_and_memory_are_settable_and_checked() {
         assert!(err.contains(said), "{all:?}: {err}");
         assert!(!out.exists(), "{all:?} wrote its folder before refusing");
     };
-    refused(&["--emit", "slurm", "--time", "4h"], "t", "--time 4h: not a Slurm time limit");
-    refused(&["--emit", "slurm", "--mem", "4GB"], "m", "--mem 4GB: not a Slurm memory size");
-    refused(&["--emit", "parallel", "--mem", "4G"], "p", "--mem is what each task");
+    refused(
+        &["--emit", "slurm", "--time", "4h"],
+        "t",
+        "--time 4h: not a Slurm time limit",
+    );
+    refused(
+        &["--emit", "slurm", "--mem", "4GB"],
+        "m",
+        "--mem 4GB: not a Slurm memory size",
+    );
+    refused(
+        &["--emit", "parallel", "--mem", "4G"],
+        "p",
+        "--mem is what each task",
+    );
     refused(&["--time", "10"], "l", "--time is what each task");
 }

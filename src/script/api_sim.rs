@@ -947,7 +947,8 @@ const SUSPECT_MODULUS_MPA: f64 = 1000.0;
 /// sheet metal's in GPa (or Pa) in a model of mm and N, the line that says so. The modulus
 /// is read from the elastic tangent as 1 / (C^-1)_11, exact for isotropic elasticity.
 fn units_hint(sim: &Simulation, units: &crate::output::Units) -> Option<String> {
-    let in_mm_n = matches!(units.length.as_str(), "" | "mm") && matches!(units.force.as_str(), "" | "N");
+    let in_mm_n =
+        matches!(units.length.as_str(), "" | "mm") && matches!(units.force.as_str(), "" | "N");
     if !sim.history.is_empty() || !in_mm_n {
         return None;
     }

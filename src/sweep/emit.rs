@@ -73,7 +73,10 @@ impl Default for SlurmResources {
 /// Slurm's time forms: `M`, `M:S`, `H:M:S`, `D-H`, `D-H:M`, `D-H:M:S`, all fields
 /// unsigned integers.
 fn check_slurm_time(time: &str) -> Result<()> {
-    let fields = |t: &str| t.split(':').all(|f| !f.is_empty() && f.bytes().all(|b| b.is_ascii_digit()));
+    let fields = |t: &str| {
+        t.split(':')
+            .all(|f| !f.is_empty() && f.bytes().all(|b| b.is_ascii_digit()))
+    };
     let ok = match time.split_once('-') {
         Some((days, rest)) => {
             !days.is_empty()
@@ -121,12 +124,7 @@ fn slurm_mem_mib(mem: &str) -> Result<u64> {
 
 /// Writes the sweep's index, commands.txt and, for Slurm, sweep.slurm; returns what to
 /// type to start it. `slurm`: the resources each task asks for (Slurm only).
-pub fn write(
-    sweep: &Sweep,
-    target: Target,
-    jobs: usize,
-    slurm: &SlurmResources,
-) -> Result<String> {
+pub fn write(sweep: &Sweep, target: Target, jobs: usize, slurm: &SlurmResources) -> Result<String> {
     sweep.write_index()?;
     let commands = sweep.out.join(COMMANDS_FILE);
     let mut text = String::new();
@@ -215,7 +213,17 @@ mod tests {
         for good in ["90", "30:00", "04:00:00", "1-12", "1-12:30", "2-00:00:00"] {
             assert!(check_slurm_time(good).is_ok(), "{good}");
         }
-        for bad in ["", "0", "00:00:00", "1:2:3:4", "1h", "-5", "1-", "4:00:x", "1-2:3:4:5"] {
+        for bad in [
+            "",
+            "0",
+            "00:00:00",
+            "1:2:3:4",
+            "1h",
+            "-5",
+            "1-",
+            "4:00:x",
+            "1-2:3:4:5",
+        ] {
             let e = check_slurm_time(bad).unwrap_err().to_string();
             assert!(e.contains(&format!("--time {bad}:")), "{bad}: {e}");
         }
@@ -224,7 +232,16 @@ mod tests {
         assert_eq!(slurm_mem_mib("512m").unwrap(), 512);
         assert_eq!(slurm_mem_mib("2T").unwrap(), 2 << 20);
         assert_eq!(slurm_mem_mib("2048K").unwrap(), 2);
-        for bad in ["", "G", "4X", "-1G", "0", "1K", "4.5G", "99999999999999999999T"] {
+        for bad in [
+            "",
+            "G",
+            "4X",
+            "-1G",
+            "0",
+            "1K",
+            "4.5G",
+            "99999999999999999999T",
+        ] {
             let e = slurm_mem_mib(bad).unwrap_err().to_string();
             assert!(e.contains(&format!("--mem {bad}:")), "{bad}: {e}");
         }
