@@ -91,3 +91,24 @@ pub fn face_normal(face: &Face, u: f64, v: f64) -> Vec3 {
         n
     }
 }
+
+/// Checks a face's parameter box `got` against `want` to `tol`: u is an angle on every
+/// surface of revolution, taken modulo a turn, and so is v where `v_is_angle`.
+pub fn assert_parameter_box(
+    kind: &str,
+    got: [[f64; 2]; 2],
+    want: [[f64; 2]; 2],
+    v_is_angle: bool,
+    tol: f64,
+) {
+    let tau = std::f64::consts::TAU;
+    for d in 0..2 {
+        for k in 0..2 {
+            let mut off = got[d][k] - want[d][k];
+            if d == 0 || v_is_angle {
+                off -= tau * (off / tau).round();
+            }
+            assert!(off.abs() < tol, "{kind}: {got:?} against {want:?}");
+        }
+    }
+}
