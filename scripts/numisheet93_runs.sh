@@ -4,7 +4,7 @@
 # Each run writes its own folder under OUT (default out/numisheet93) with summary.json and
 # cpu.txt (/usr/bin/time -v: CPU seconds and peak memory); a run whose folder exists is
 # skipped, so the script can be re-entered, and run twice at once on the same OUT to use both
-# cores. Runs niced (the machine is shared).
+# cores. Runs niced (the machine is shared): NICE=0 gives a runner its core back.
 #
 #   scripts/numisheet93_runs.sh [OUT] [GROUP...]      GROUP: base25 pair25 sens25 base50 base100 fbar25
 #   python3 scripts/numisheet93_report.py OUT         # writes docs/validation/numisheet93.md + SVG
@@ -13,6 +13,7 @@ out=${1:-out/numisheet93}
 shift || true
 groups=${*:-base25 pair25 sens25 base50}
 tribo=${TRIBO:-target/release/tribo}
+niceness=${NICE:-19}
 mkdir -p "$out"
 
 run() { # name, then --set arguments
@@ -29,7 +30,7 @@ run() { # name, then --set arguments
     for s in "${defaults[@]}" "$@"; do
         sets+=(--set "$s")
     done
-    nice -n 19 /usr/bin/time -v -o "$dir/cpu.txt" "$tribo" run scripts/square_cup.rhai --quiet \
+    nice -n "$niceness" /usr/bin/time -v -o "$dir/cpu.txt" "$tribo" run scripts/square_cup.rhai --quiet \
         --out "$dir" "${sets[@]}" > "$dir/log.txt" 2>&1 || echo "FAILED $name (see $dir/log.txt)"
 }
 
