@@ -169,6 +169,142 @@ def pair_table(runs):
     return "\n".join(lines)
 
 
+# The mesh sequence: the solid-shell 25 x 25, 50 x 50 and 100 x 100 x 1 sheets, h the in-plane
+# cell of the 75 mm quarter blank, finest first.
+SEQUENCE = [("ss100", 0.75), ("ss50", 1.5), ("ss25", 3.0)]
+TRAVELS = (15, 40)
+LINES = (("edge", "edge midline (y = 0)"), ("diagonal", "diagonal (x = y)"))
+
+
+def tribo_binary():
+    return os.environ.get("TRIBO", os.path.join(ROOT, "target", "release", "tribo"))
+
+
+def extrapolate(quantities):
+    """The engine's Richardson extrapolation (`tribo extrapolate`, src/study/richardson.rs) of
+    {name: [[h, value] x 3]}: observed order, asymptotic verdict, GCI band."""
+    doc = json.dumps({"quantities": quantities})
+    done = subprocess.run([tribo_binary(), "extrapolate", "-"], input=doc,
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"tribo extrapolate failed: {done.stderr.strip()}")
+    return json.loads(done.stdout)["quantities"]
+
+
+def thickness_profile(run, travel, line):
+    """[[s, ln(t/t0)], ...] of a run along a line at a report travel, or None."""
+    for entry in run["summary"].get("thickness_strain_lines", []):
+        if round(entry["punch_travel"]) == travel:
+            return entry[line]
+    return None
+
+
+def sequence_of(runs, key):
+    """The three members of a material's sequence and the extrapolation of every quantity
+    (draw-ins, punch peak, thickness strain at each station), or None if one is missing."""
+    members = [(runs.get(f"{key}_{mesh}"), h) for mesh, h in SEQUENCE]
+    if any(run is None for run, _ in members):
+        return None
+    quantities = {}
+    for q, mm in QUANTITIES:
+        quantities[f"{q.upper()} {mm}"] = [[h, run["draw"][(q, mm)]] for run, h in members]
+    quantities["punch peak"] = [[h, run["peak"] / 1000.0] for run, h in members]
+    for mm in TRAVELS:
+        for line, _ in LINES:
+            profiles = [thickness_profile(run, mm, line) for run, _ in members]
+            if any(p is None for p in profiles):
+                continue
+            for i in range(len(profiles[0])):
+                quantities[f"eps {line} {mm} {i}"] = [[h, p[i][1]] for p, (_, h) in zip(profiles, members)]
+    return {"members": members, "result": extrapolate(quantities)}
+
+
+def sequence_table(seq, measured, label):
+    lines = ["| quantity | 25 x 25 | 50 x 50 | 100 x 100 | observed order | R | extrapolated | GCI band | band / value | asymptotic | measured |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    res = seq["result"]
+    names = [f"{q.upper()} {mm}" for q, mm in QUANTITIES] + ["punch peak"]
+    for name in names:
+        e = res[name]
+        row = [fmt(run["draw"][(name.split()[0].lower(), int(name.split()[1]))], 3) if name != "punch peak"
+               else fmt(run["peak"] / 1000.0, 2) for run, _ in reversed(seq["members"])]
+        p = e["observed_order"]
+        mean = None
+        if name != "punch peak":
+            q, mm = name.split()
+            mean, _ = measured_value(measured, label, q.lower(), int(mm))
+        lines.append(f"| {name}{' [kN]' if name == 'punch peak' else ' [mm]'} | " + " | ".join(row)
+                     + f" | {'–' if p is None else f'{p:.2f}'} | {e['convergence_ratio']:.3f} | {e['value']:.3f}"
+                     + f" | ± {e['uncertainty']:.3f} | {100.0 * e['relative_uncertainty']:.2f} % | {'yes' if e['asymptotic'] else 'no'} | {fmt(mean)} |")
+    return "\n".join(lines)
+
+
+def thickness_table(seq):
+    """Thickness strain at every fifth station at 40 mm: the three meshes, the extrapolated
+    value and its band; and the widest band along each line at both travels."""
+    res = seq["result"]
+    lines = ["| line | travel [mm] | widest GCI band of ln(t/t0) | where (reference distance from the centre) | stations asymptotic |",
+             "|---|---|---|---|---|"]
+    for mm in TRAVELS:
+        for line, label in LINES:
+            keys = [k for k in res if k.startswith(f"eps {line} {mm} ")]
+            if not keys:
+                continue
+            profile = thickness_profile(seq["members"][0][0], mm, line)
+            widest = max(keys, key=lambda k: res[k]["uncertainty"])
+            at = profile[int(widest.split()[-1])][0]
+            asym = sum(1 for k in keys if res[k]["asymptotic"])
+            lines.append(f"| {label} | {mm} | ± {res[widest]['uncertainty']:.4f} | {at:.1f} mm | {asym} of {len(keys)} |")
+    return "\n".join(lines)
+
+
+def thickness_svg(seqs, path):
+    """ln(t/t0) at 40 mm along the edge midline and the diagonal: each mesh of the sequence
+    and the extrapolated profile with its GCI band (grey), per material."""
+    panels = [(label, line, title, seq) for label, seq in seqs.items() if seq for line, title in LINES]
+    if not panels:
+        return False
+    pw, ph, left, top = 360, 260, 50, 40
+    width, height = 20 + pw * 2, top + (ph + 50) * ((len(panels) + 1) // 2) + 30
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" font-size="11">',
+           f'<text x="{width / 2}" y="20" text-anchor="middle" font-size="14">Thickness strain ln(t/t0) at 40 mm of punch travel: mesh sequence and extrapolation</text>']
+    colours = {"ss25": "#1f77b4", "ss50": "#d62728", "ss100": "#2ca02c"}
+    for k, (label, line, title, seq) in enumerate(panels):
+        x0, y0 = 10 + pw * (k % 2), top + (ph + 50) * (k // 2)
+        res = seq["result"]
+        profiles = {mesh: thickness_profile(run, 40, line) for (run, _), (mesh, _) in zip(seq["members"], SEQUENCE)}
+        keys = sorted((int(key.split()[-1]), key) for key in res if key.startswith(f"eps {line} 40 "))
+        ext = [(profiles["ss100"][i][0], res[key]["value"], res[key]["uncertainty"]) for i, key in keys]
+        vals = [v for p in profiles.values() for _, v in p] + [v + u for _, v, u in ext] + [v - u for _, v, u in ext]
+        smax = max(s for s, _, _ in ext)
+        lo, hi = min(vals), max(vals)
+        lo, hi = lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)
+        X = lambda s: x0 + left + (pw - left - 20) * s / smax
+        Y = lambda v: y0 + 20 + (ph - 40) * (hi - v) / (hi - lo)
+        out.append(f'<text x="{x0 + pw / 2}" y="{y0 + 12}" text-anchor="middle">{label}, {title}</text>')
+        out.append(f'<rect x="{X(0):.1f}" y="{Y(hi):.1f}" width="{X(smax) - X(0):.1f}" height="{Y(lo) - Y(hi):.1f}" fill="none" stroke="#999"/>')
+        for v in (lo, 0.5 * (lo + hi), hi):
+            out.append(f'<text x="{X(0) - 4:.1f}" y="{Y(v) + 4:.1f}" text-anchor="end">{v:.3f}</text>')
+        out.append(f'<text x="{X(smax):.1f}" y="{Y(lo) + 14:.1f}" text-anchor="end">{smax:.0f} mm from the centre</text>')
+        band = " ".join(f"{X(s):.1f},{Y(v + u):.1f}" for s, v, u in ext) + " " + " ".join(
+            f"{X(s):.1f},{Y(v - u):.1f}" for s, v, u in reversed(ext))
+        out.append(f'<polygon points="{band}" fill="#ccc"/>')
+        for mesh, profile in profiles.items():
+            pts = " ".join(f"{X(s):.1f},{Y(v):.1f}" for s, v in profile)
+            out.append(f'<polyline points="{pts}" fill="none" stroke="{colours[mesh]}" stroke-width="1.2"/>')
+        pts = " ".join(f"{X(s):.1f},{Y(v):.1f}" for s, v, _ in ext)
+        out.append(f'<polyline points="{pts}" fill="none" stroke="black" stroke-dasharray="4 3" stroke-width="1.5"/>')
+    lx = 20
+    for label, colour in (("25 x 25", colours["ss25"]), ("50 x 50", colours["ss50"]), ("100 x 100", colours["ss100"]),
+                          ("extrapolated (dashed) with its GCI band (grey)", "black")):
+        out.append(f'<rect x="{lx}" y="{height - 18}" width="10" height="10" fill="{colour}"/><text x="{lx + 14}" y="{height - 9}">{label}</text>')
+        lx += 110
+    out.append("</svg>")
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+    return True
+
+
 def svg_chart(runs, measured, path):
     """Simulated against measured draw-in, one column per quantity and material: the
     measurement as a black bar (with its scatter band, grey, where published), each run a
@@ -235,6 +371,17 @@ def main():
                 f"{hexa['draw'][qm] - base['draw'][qm]:+.3f}" if qm in hexa["draw"] and qm in base["draw"] else "–"
                 for qm in QUANTITIES)
     element_rows = "\n".join(f"| {label}: F-bar 25 x 25 x 1 instead of solid-shell | {row} |" for label, row in element.items()) or "| (F-bar runs not finished this session) | |"
+    seqs = {label: sequence_of(runs, key) for key, label in MATERIALS}
+    missing = "(a member of the sequence did not finish: `scripts/numisheet93_runs.sh OUT base25 base50 base100`)"
+    for label, seq in seqs.items():
+        text = text.replace("{{SEQUENCE_%s}}" % label.upper(),
+                            sequence_table(seq, measured, label) if seq else missing)
+        text = text.replace("{{THICKNESS_%s}}" % label.upper(), thickness_table(seq) if seq else missing)
+    thickness_svg(seqs, os.path.join(DOC, "numisheet93_thickness.svg"))
+    with open(os.path.join(DOC, "numisheet93_sequence.json"), "w") as f:
+        json.dump({label: None if seq is None else {
+            "h": [h for _, h in SEQUENCE], "extrapolations": seq["result"]} for label, seq in seqs.items()},
+            f, indent=1)
     text = (text.replace("{{COMMIT}}", git_commit())
             .replace("{{RESULTS}}", results_table(runs, measured))
             .replace("{{DIFFERENCES}}", difference_table(runs, measured))

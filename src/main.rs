@@ -45,6 +45,14 @@ enum Command {
         #[command(flatten)]
         limits: Limits,
     },
+    /// Richardson extrapolation of mesh sequences given as JSON (FILE, or - for standard
+    /// input): {"rule": {"min", "max", "assumed"} (optional), "quantities": {NAME: [[h, value]
+    /// x 3]}}; prints each quantity's extrapolated value, observed order, asymptotic verdict
+    /// and GCI band as JSON (the study's own rules: src/study/richardson.rs).
+    Extrapolate {
+        /// The input JSON file, or - for standard input.
+        file: PathBuf,
+    },
     /// Speed against accuracy: work-precision charts and stability maps with a report.
     Study {
         /// hertz, friction_work, cylinder_drag, square_cup, stability, all, report (only
@@ -366,6 +374,7 @@ fn main() -> ExitCode {
             eprintln!("results in {}", host.out_dir.display());
             Ok(())
         })(),
+        Command::Extrapolate { file } => extrapolate(&file),
         Command::Study { name, out, quiet } => {
             let out = out.unwrap_or_else(|| PathBuf::from("out/studies"));
             let command = format!("tribo study {name} --out {}", out.display());
@@ -439,4 +448,35 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `tribo extrapolate FILE`: the input read (at most 16 MB, a regular file or standard
+/// input), the extrapolations printed as JSON.
+fn extrapolate(file: &std::path::Path) -> tribo::Result<()> {
+    use std::io::Read;
+    let (text, source) = if file == std::path::Path::new("-") {
+        let mut text = String::new();
+        std::io::stdin()
+            .take(16 << 20)
+            .read_to_string(&mut text)
+            .map_err(|e| tribo::Error::Input(format!("standard input: {e}")))?;
+        (text, "standard input".to_string())
+    } else {
+        let meta = std::fs::metadata(file)
+            .map_err(|e| tribo::Error::Input(format!("{}: {e}", file.display())))?;
+        if !meta.is_file() || meta.len() > 16 << 20 {
+            return Err(tribo::Error::Input(format!(
+                "{}: not a regular file of at most 16 MB",
+                file.display()
+            )));
+        }
+        let text = std::fs::read_to_string(file)
+            .map_err(|e| tribo::Error::Input(format!("{}: {e}", file.display())))?;
+        (text, file.display().to_string())
+    };
+    let out = tribo::study::extrapolate::run(&text, &source)?;
+    let json = serde_json::to_string_pretty(&out)
+        .map_err(|e| tribo::Error::Input(format!("extrapolate: {e}")))?;
+    println!("{json}");
+    Ok(())
 }

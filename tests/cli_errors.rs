@@ -145,3 +145,48 @@ fn endless_loop_stops_with_a_clear_message() {
         "{err}"
     );
 }
+
+/// `tribo extrapolate`: a first-order sequence read from standard input gives its limit and
+/// order (f = 5 - 2h on h = 1, 2, 4: R = 1/2, p = 1, f_ext = 5 exactly); a quantity with two
+/// meshes is refused naming it.
+#[test]
+fn extrapolate_reads_a_sequence_and_names_a_bad_quantity() {
+    use std::io::Write;
+    let run = |input: &str| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_tribo"))
+            .args(["extrapolate", "-"])
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(input.as_bytes())
+            .unwrap();
+        child.wait_with_output().unwrap()
+    };
+    let out = run(r#"{"quantities": {"DX 40": [[2, 1], [1, 3], [4, -3]]}}"#);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let dx = &doc["quantities"]["DX 40"];
+    assert!((dx["value"].as_f64().unwrap() - 5.0).abs() < 1e-12, "{doc}");
+    assert!(
+        (dx["observed_order"].as_f64().unwrap() - 1.0).abs() < 1e-9,
+        "{doc}"
+    );
+    assert_eq!(dx["asymptotic"], true);
+    let bad = run(r#"{"quantities": {"DD 15": [[1, 2], [2, 3]]}}"#);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("\"DD 15\" has 2") && err.contains("standard input"),
+        "{err}"
+    );
+}

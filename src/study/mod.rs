@@ -17,6 +17,7 @@
 
 pub mod chart;
 pub mod cup_reference;
+pub mod extrapolate;
 pub mod report;
 pub mod richardson;
 pub mod scenes;
