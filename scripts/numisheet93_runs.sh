@@ -6,7 +6,7 @@
 # skipped, so the script can be re-entered, and run twice at once on the same OUT to use both
 # cores. Runs niced (the machine is shared): NICE=0 gives a runner its core back.
 #
-#   scripts/numisheet93_runs.sh [OUT] [GROUP...]      GROUP: base25 pair25 sens25 base50 base100 fbar25
+#   scripts/numisheet93_runs.sh [OUT] [GROUP...]      GROUP: base25 pair25 sens25 base35 base50 base71 base100 fbar25
 #   python3 scripts/numisheet93_report.py OUT         # writes docs/validation/numisheet93.md + SVG
 set -euo pipefail
 out=${1:-out/numisheet93}
@@ -51,6 +51,10 @@ for g in $groups; do
              done ;;
     base50)  for m in aluminium_1993 steel; do
                  run "${m}_ss50" material="\"$m\"" yield_kind='"hill48"' cells=50; done ;;
+    base35)  for m in aluminium_1993 steel; do
+                 run "${m}_ss35" material="\"$m\"" yield_kind='"hill48"' cells=35; done ;;
+    base71)  for m in aluminium_1993 steel; do
+                 run "${m}_ss71" material="\"$m\"" yield_kind='"hill48"' cells=71; done ;;
     base100) for m in aluminium_1993 steel; do
                  run "${m}_ss100" material="\"$m\"" yield_kind='"hill48"' cells=100; done ;;
     fbar25)  for m in aluminium_1993 steel; do
