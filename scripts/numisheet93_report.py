@@ -95,12 +95,11 @@ def results_table(runs, measured):
     lines = ["| material | model | DX 15 | DY 15 | DD 15 | DX 40 | DY 40 | DD 40 | punch peak [kN] | CPU [s] | peak memory [MB] |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for key, label in MATERIALS:
-        for mesh in ("ss25", "ss50", "ss100", "hex25"):
+        for mesh in [m for m, _ in reversed(MESHES)] + ["hex25"]:
             run = runs.get(f"{key}_{mesh}")
             if run is None:
                 continue
-            model = {"ss25": "solid-shell 25 x 25 x 1", "ss50": "solid-shell 50 x 50 x 1",
-                     "ss100": "solid-shell 100 x 100 x 1", "hex25": "F-bar 25 x 25 x 1"}[mesh]
+            model = MODEL[mesh]
             cells = [fmt(run["draw"].get(qm)) for qm in QUANTITIES]
             peak = None if run["peak"] is None else run["peak"] / 1000.0
             lines.append(f"| {label} | {model} | " + " | ".join(cells)
@@ -117,7 +116,7 @@ def difference_table(runs, measured):
     lines = ["| material | model | DX 15 | DY 15 | DD 15 | DX 40 | DY 40 | DD 40 |",
              "|---|---|---|---|---|---|---|---|"]
     for key, label in MATERIALS:
-        for mesh in ("ss25", "ss50", "hex25"):
+        for mesh in [m for m, _ in reversed(MESHES)] + ["hex25"]:
             run = runs.get(f"{key}_{mesh}")
             if run is None:
                 continue
@@ -169,11 +168,17 @@ def pair_table(runs):
     return "\n".join(lines)
 
 
-# The mesh sequence: the solid-shell 25 x 25, 50 x 50 and 100 x 100 x 1 sheets, h the in-plane
-# cell of the 75 mm quarter blank, finest first.
-SEQUENCE = [("ss100", 0.75), ("ss50", 1.5), ("ss25", 3.0)]
+# The solid-shell meshes of the sequences, finest first: (run suffix, cells per edge of the
+# 75 mm quarter blank); h = 75 / cells. Two sequences share 50 x 50: 25, 50, 100 (ratio 2)
+# and 35, 50, 71 (ratio about sqrt 2).
+MESHES = [("ss100", 100), ("ss71", 71), ("ss50", 50), ("ss35", 35), ("ss25", 25)]
+MODEL = {mesh: f"solid-shell {n} x {n} x 1" for mesh, n in MESHES}
+MODEL["hex25"] = "F-bar 25 x 25 x 1"
+COLOURS = {"ss25": "#1f77b4", "ss35": "#9467bd", "ss50": "#d62728", "ss71": "#ff7f0e",
+           "ss100": "#2ca02c", "hex25": "#8c564b"}
 TRAVELS = (15, 40)
-LINES = (("edge", "edge midline (y = 0)"), ("diagonal", "diagonal (x = y)"))
+LINES = (("edge", "edge midline (y = 0)", 1.0), ("diagonal", "diagonal (x = y)", 2 ** 0.5))
+STATIONS = 25  # common stations every 3 mm of the reference blank along each line
 
 
 def tribo_binary():
@@ -191,43 +196,63 @@ def extrapolate(quantities):
     return json.loads(done.stdout)["quantities"]
 
 
-def thickness_profile(run, travel, line):
-    """[[s, ln(t/t0)], ...] of a run along a line at a report travel, or None."""
+def thickness_at_stations(run, travel, line, scale):
+    """ln(t/t0) of a run along a line at a report travel, at the common stations (every 3 mm
+    of x along the line): linear interpolation between the run's nodes on the line (exact where
+    a station is a node, as on 25, 50 and 100 cells), or None when the run has no profile."""
     for entry in run["summary"].get("thickness_strain_lines", []):
         if round(entry["punch_travel"]) == travel:
-            return entry[line]
+            profile = sorted({round(p[0], 9): p[1] for p in entry[line]}.items())
+            out = []
+            for i in range(STATIONS + 1):
+                s = scale * 75.0 * i / STATIONS
+                for (s0, v0), (s1, v1) in zip(profile, profile[1:]):
+                    if s0 - 1e-6 <= s <= s1 + 1e-6:
+                        w = 0.0 if s1 == s0 else min(max((s - s0) / (s1 - s0), 0.0), 1.0)
+                        out.append([s, v0 + w * (v1 - v0)])
+                        break
+                else:
+                    return None
+            return out
     return None
 
 
-def sequence_of(runs, key):
-    """The three members of a material's sequence and the extrapolation of every quantity
-    (draw-ins, punch peak, thickness strain at each station), or None if one is missing."""
-    members = [(runs.get(f"{key}_{mesh}"), h) for mesh, h in SEQUENCE]
-    if any(run is None for run, _ in members):
+def sequence_of(runs, key, meshes):
+    """Three members of a material's sequence (finest first) and the extrapolation of every
+    quantity (draw-ins, punch peak, thickness strain at each station), or None if one is
+    missing."""
+    members = [(runs.get(f"{key}_{mesh}"), mesh, 75.0 / cells) for mesh, cells in MESHES if mesh in meshes]
+    if len(members) != 3 or any(run is None for run, _, _ in members):
         return None
     quantities = {}
     for q, mm in QUANTITIES:
-        quantities[f"{q.upper()} {mm}"] = [[h, run["draw"][(q, mm)]] for run, h in members]
-    quantities["punch peak"] = [[h, run["peak"] / 1000.0] for run, h in members]
+        quantities[f"{q.upper()} {mm}"] = [[h, run["draw"][(q, mm)]] for run, _, h in members]
+    quantities["punch peak"] = [[h, run["peak"] / 1000.0] for run, _, h in members]
     for mm in TRAVELS:
-        for line, _ in LINES:
-            profiles = [thickness_profile(run, mm, line) for run, _ in members]
+        for line, _, scale in LINES:
+            profiles = [thickness_at_stations(run, mm, line, scale) for run, _, _ in members]
             if any(p is None for p in profiles):
                 continue
-            for i in range(len(profiles[0])):
-                quantities[f"eps {line} {mm} {i}"] = [[h, p[i][1]] for p, (_, h) in zip(profiles, members)]
+            for i in range(STATIONS + 1):
+                quantities[f"eps {line} {mm} {i}"] = [[h, p[i][1]] for p, (_, _, h) in zip(profiles, members)]
     return {"members": members, "result": extrapolate(quantities)}
 
 
+def draw_value(run, name):
+    if name == "punch peak":
+        return run["peak"] / 1000.0
+    q, mm = name.split()
+    return run["draw"][(q.lower(), int(mm))]
+
+
 def sequence_table(seq, measured, label):
-    lines = ["| quantity | 25 x 25 | 50 x 50 | 100 x 100 | observed order | R | extrapolated | GCI band | band / value | asymptotic | measured |",
+    cells = " | ".join(MODEL[mesh].split()[1] + " x " + MODEL[mesh].split()[3] for _, mesh, _ in reversed(seq["members"]))
+    lines = [f"| quantity | {cells} | observed order | R | extrapolated | GCI band | band / value | asymptotic | measured |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     res = seq["result"]
-    names = [f"{q.upper()} {mm}" for q, mm in QUANTITIES] + ["punch peak"]
-    for name in names:
+    for name in [f"{q.upper()} {mm}" for q, mm in QUANTITIES] + ["punch peak"]:
         e = res[name]
-        row = [fmt(run["draw"][(name.split()[0].lower(), int(name.split()[1]))], 3) if name != "punch peak"
-               else fmt(run["peak"] / 1000.0, 2) for run, _ in reversed(seq["members"])]
+        row = [fmt(draw_value(run, name), 3 if name != "punch peak" else 2) for run, _, _ in reversed(seq["members"])]
         p = e["observed_order"]
         mean = None
         if name != "punch peak":
@@ -239,89 +264,117 @@ def sequence_table(seq, measured, label):
     return "\n".join(lines)
 
 
+def order_check_table(seqs):
+    """The observed order of each draw-in from every sequence that could be formed: where the
+    sequences agree, the meshes are in the asymptotic range."""
+    lines = ["| material | meshes | " + " | ".join(f"{q.upper()} {mm}" for q, mm in QUANTITIES) + " | punch peak |",
+             "|---|---|" + "---|" * (len(QUANTITIES) + 1)]
+    n = 0
+    for (label, meshes), seq in seqs.items():
+        if seq is None:
+            continue
+        n += 1
+        res = seq["result"]
+        names = [f"{q.upper()} {mm}" for q, mm in QUANTITIES] + ["punch peak"]
+        cells = ", ".join(MODEL[m].split()[1] for m in reversed(meshes))
+        lines.append(f"| {label} | {cells} | " + " | ".join(
+            "–" if res[k]["observed_order"] is None else f"{res[k]['observed_order']:.2f}" + ("" if res[k]["asymptotic"] else " (not asymptotic)")
+            for k in names) + " |")
+    return "\n".join(lines) if n else "(no sequence of three meshes finished)"
+
+
 def thickness_table(seq):
-    """Thickness strain at every fifth station at 40 mm: the three meshes, the extrapolated
-    value and its band; and the widest band along each line at both travels."""
+    """The widest GCI band along each line at both travels, where, and how many stations
+    show the asymptotic range."""
     res = seq["result"]
-    lines = ["| line | travel [mm] | widest GCI band of ln(t/t0) | where (reference distance from the centre) | stations asymptotic |",
-             "|---|---|---|---|---|"]
+    lines = ["| line | travel [mm] | widest GCI band of ln(t/t0) | where (reference distance from the centre) | largest thinning (extrapolated) | stations asymptotic |",
+             "|---|---|---|---|---|---|"]
     for mm in TRAVELS:
-        for line, label in LINES:
+        for line, label, scale in LINES:
             keys = [k for k in res if k.startswith(f"eps {line} {mm} ")]
             if not keys:
                 continue
-            profile = thickness_profile(seq["members"][0][0], mm, line)
             widest = max(keys, key=lambda k: res[k]["uncertainty"])
-            at = profile[int(widest.split()[-1])][0]
+            thinnest = min(keys, key=lambda k: res[k]["value"])
+            at = lambda k: scale * 75.0 * int(k.split()[-1]) / STATIONS
             asym = sum(1 for k in keys if res[k]["asymptotic"])
-            lines.append(f"| {label} | {mm} | ± {res[widest]['uncertainty']:.4f} | {at:.1f} mm | {asym} of {len(keys)} |")
+            lines.append(f"| {label} | {mm} | ± {res[widest]['uncertainty']:.4f} | {at(widest):.1f} mm"
+                         + f" | {res[thinnest]['value']:.4f} ± {res[thinnest]['uncertainty']:.4f} at {at(thinnest):.1f} mm | {asym} of {len(keys)} |")
     return "\n".join(lines)
 
 
 def thickness_svg(seqs, path):
     """ln(t/t0) at 40 mm along the edge midline and the diagonal: each mesh of the sequence
     and the extrapolated profile with its GCI band (grey), per material."""
-    panels = [(label, line, title, seq) for label, seq in seqs.items() if seq for line, title in LINES]
+    panels = [(label, line, title, scale, seq) for label, seq in seqs.items() if seq for line, title, scale in LINES]
     if not panels:
         return False
     pw, ph, left, top = 360, 260, 50, 40
     width, height = 20 + pw * 2, top + (ph + 50) * ((len(panels) + 1) // 2) + 30
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" font-size="11">',
            f'<text x="{width / 2}" y="20" text-anchor="middle" font-size="14">Thickness strain ln(t/t0) at 40 mm of punch travel: mesh sequence and extrapolation</text>']
-    colours = {"ss25": "#1f77b4", "ss50": "#d62728", "ss100": "#2ca02c"}
-    for k, (label, line, title, seq) in enumerate(panels):
+    meshes_drawn = []
+    for k, (label, line, title, scale, seq) in enumerate(panels):
         x0, y0 = 10 + pw * (k % 2), top + (ph + 50) * (k // 2)
         res = seq["result"]
-        profiles = {mesh: thickness_profile(run, 40, line) for (run, _), (mesh, _) in zip(seq["members"], SEQUENCE)}
-        keys = sorted((int(key.split()[-1]), key) for key in res if key.startswith(f"eps {line} 40 "))
-        ext = [(profiles["ss100"][i][0], res[key]["value"], res[key]["uncertainty"]) for i, key in keys]
+        profiles = {mesh: thickness_at_stations(run, 40, line, scale) for run, mesh, _ in seq["members"]}
+        meshes_drawn += [m for m in profiles if m not in meshes_drawn]
+        ext = [(scale * 75.0 * i / STATIONS, res[f"eps {line} 40 {i}"]["value"], res[f"eps {line} 40 {i}"]["uncertainty"])
+               for i in range(STATIONS + 1)]
         vals = [v for p in profiles.values() for _, v in p] + [v + u for _, v, u in ext] + [v - u for _, v, u in ext]
-        smax = max(s for s, _, _ in ext)
+        smax = ext[-1][0]
         lo, hi = min(vals), max(vals)
         lo, hi = lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)
         X = lambda s: x0 + left + (pw - left - 20) * s / smax
         Y = lambda v: y0 + 20 + (ph - 40) * (hi - v) / (hi - lo)
         out.append(f'<text x="{x0 + pw / 2}" y="{y0 + 12}" text-anchor="middle">{label}, {title}</text>')
         out.append(f'<rect x="{X(0):.1f}" y="{Y(hi):.1f}" width="{X(smax) - X(0):.1f}" height="{Y(lo) - Y(hi):.1f}" fill="none" stroke="#999"/>')
+        if lo < 0.0 < hi:
+            out.append(f'<line x1="{X(0):.1f}" x2="{X(smax):.1f}" y1="{Y(0):.1f}" y2="{Y(0):.1f}" stroke="#bbb" stroke-dasharray="2 2"/>')
         for v in (lo, 0.5 * (lo + hi), hi):
             out.append(f'<text x="{X(0) - 4:.1f}" y="{Y(v) + 4:.1f}" text-anchor="end">{v:.3f}</text>')
-        out.append(f'<text x="{X(smax):.1f}" y="{Y(lo) + 14:.1f}" text-anchor="end">{smax:.0f} mm from the centre</text>')
+        out.append(f'<text x="{X(smax):.1f}" y="{Y(lo) + 14:.1f}" text-anchor="end">{smax:.0f} mm from the centre (reference blank)</text>')
         band = " ".join(f"{X(s):.1f},{Y(v + u):.1f}" for s, v, u in ext) + " " + " ".join(
             f"{X(s):.1f},{Y(v - u):.1f}" for s, v, u in reversed(ext))
         out.append(f'<polygon points="{band}" fill="#ccc"/>')
         for mesh, profile in profiles.items():
             pts = " ".join(f"{X(s):.1f},{Y(v):.1f}" for s, v in profile)
-            out.append(f'<polyline points="{pts}" fill="none" stroke="{colours[mesh]}" stroke-width="1.2"/>')
+            out.append(f'<polyline points="{pts}" fill="none" stroke="{COLOURS[mesh]}" stroke-width="1.2"/>')
         pts = " ".join(f"{X(s):.1f},{Y(v):.1f}" for s, v, _ in ext)
         out.append(f'<polyline points="{pts}" fill="none" stroke="black" stroke-dasharray="4 3" stroke-width="1.5"/>')
     lx = 20
-    for label, colour in (("25 x 25", colours["ss25"]), ("50 x 50", colours["ss50"]), ("100 x 100", colours["ss100"]),
-                          ("extrapolated (dashed) with its GCI band (grey)", "black")):
-        out.append(f'<rect x="{lx}" y="{height - 18}" width="10" height="10" fill="{colour}"/><text x="{lx + 14}" y="{height - 9}">{label}</text>')
-        lx += 110
+    for mesh in meshes_drawn:
+        n = MODEL[mesh].split()[1]
+        out.append(f'<rect x="{lx}" y="{height - 18}" width="10" height="10" fill="{COLOURS[mesh]}"/><text x="{lx + 14}" y="{height - 9}">{n} x {n}</text>')
+        lx += 90
+    out.append(f'<rect x="{lx}" y="{height - 18}" width="10" height="10" fill="black"/><text x="{lx + 14}" y="{height - 9}">extrapolated (dashed) with its GCI band (grey)</text>')
     out.append("</svg>")
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")
     return True
 
 
-def svg_chart(runs, measured, path):
+def svg_chart(runs, measured, finest, path):
     """Simulated against measured draw-in, one column per quantity and material: the
     measurement as a black bar (with its scatter band, grey, where published), each run a
-    coloured marker."""
+    coloured marker, the extrapolated value of the finest mesh sequence a black diamond with
+    its GCI band."""
     columns = []
     for key, label in MATERIALS:
         for q, mm in QUANTITIES:
             mean, scatter = measured_value(measured, label, q, mm)
             sims = []
-            for mesh, colour in (("ss25", "#1f77b4"), ("ss50", "#d62728"), ("hex25", "#2ca02c")):
+            for mesh in [m for m, _ in reversed(MESHES)] + ["hex25"]:
+                colour = COLOURS[mesh]
                 run = runs.get(f"{key}_{mesh}")
                 if run is not None and (q, mm) in run["draw"]:
                     sims.append((mesh, colour, run["draw"][(q, mm)]))
             if mean is None and not sims:
                 continue
-            columns.append((f"{label[:2]} {q.upper()} {mm}", mean, scatter, sims))
-    width, height, left, top, bottom = 80 + 60 * len(columns), 420, 60, 40, 70
+            seq = finest.get(label)
+            ext = seq["result"][f"{q.upper()} {mm}"] if seq else None
+            columns.append((f"{label[:2]} {q.upper()} {mm}", mean, scatter, sims, ext))
+    width, height, left, top, bottom = max(80 + 60 * len(columns), 820), 450, 60, 40, 100
     vmax = max([c[1] or 0 for c in columns] + [s[2] for c in columns for s in c[3]] + [1.0]) * 1.1
     y = lambda v: top + (height - top - bottom) * (1.0 - v / vmax)
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" font-size="11">',
@@ -329,19 +382,27 @@ def svg_chart(runs, measured, path):
     for k in range(0, int(vmax) + 1, 5):
         out.append(f'<line x1="{left}" x2="{width - 20}" y1="{y(k):.1f}" y2="{y(k):.1f}" stroke="#ddd"/>')
         out.append(f'<text x="{left - 6}" y="{y(k) + 4:.1f}" text-anchor="end">{k}</text>')
-    for i, (name, mean, scatter, sims) in enumerate(columns):
+    for i, (name, mean, scatter, sims, ext) in enumerate(columns):
         cx = left + 30 + 60 * i
         if mean is not None:
             if scatter:
                 out.append(f'<rect x="{cx - 18}" y="{y(mean + scatter):.1f}" width="36" height="{y(mean - scatter) - y(mean + scatter):.1f}" fill="#ccc"/>')
             out.append(f'<line x1="{cx - 18}" x2="{cx + 18}" y1="{y(mean):.1f}" y2="{y(mean):.1f}" stroke="black" stroke-width="3"/>')
         for j, (mesh, colour, v) in enumerate(sims):
-            out.append(f'<circle cx="{cx - 8 + 8 * j}" cy="{y(v):.1f}" r="4" fill="{colour}"><title>{mesh}: {v:.2f}</title></circle>')
+            out.append(f'<circle cx="{cx - 14 + 5 * j}" cy="{y(v):.1f}" r="3.5" fill="{colour}"><title>{mesh}: {v:.2f}</title></circle>')
+        if ext is not None:
+            v, u, ex = ext["value"], ext["uncertainty"], cx + 20
+            out.append(f'<line x1="{ex}" x2="{ex}" y1="{y(v + u):.1f}" y2="{y(v - u):.1f}" stroke="black"/>')
+            out.append(f'<path d="M {ex} {y(v) - 5:.1f} L {ex + 4} {y(v):.1f} L {ex} {y(v) + 5:.1f} L {ex - 4} {y(v):.1f} Z" fill="black"><title>extrapolated: {v:.2f} ± {u:.2f}</title></path>')
         out.append(f'<text x="{cx}" y="{height - bottom + 16}" text-anchor="end" transform="rotate(-40 {cx} {height - bottom + 16})">{name}</text>')
     lx = left
-    for label, colour in (("measured (mean)", "black"), ("solid-shell 25x25x1", "#1f77b4"), ("solid-shell 50x50x1", "#d62728"), ("F-bar 25x25x1", "#2ca02c")):
-        out.append(f'<rect x="{lx}" y="{height - 18}" width="10" height="10" fill="{colour}"/><text x="{lx + 14}" y="{height - 9}">{label}</text>')
-        lx += 150
+    present = [m for m, _ in reversed(MESHES) if any(f"{k}_{m}" in runs for k, _ in MATERIALS)]
+    present += ["hex25"] if any(f"{k}_hex25" in runs for k, _ in MATERIALS) else []
+    items = [("measured (mean)", "black")] + [(MODEL[m].replace("solid-shell ", "SS ").replace(" x 1", ""), COLOURS[m]) for m in present]
+    items += [("extrapolated ± GCI (diamond)", "black")] if any(c[4] for c in columns) else []
+    for k, (label, colour) in enumerate(items):
+        lx, ly = left + 190 * (k % 4), height - 34 + 16 * (k // 4)
+        out.append(f'<rect x="{lx}" y="{ly}" width="10" height="10" fill="{colour}"/><text x="{lx + 14}" y="{ly + 9}">{label}</text>')
     out.append("</svg>")
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")
@@ -356,7 +417,6 @@ def main():
             runs[name] = run
     with open(os.path.join(DOC, "numisheet93_measured.json")) as f:
         measured = json.load(f)
-    svg_chart(runs, measured, os.path.join(DOC, "numisheet93.svg"))
     template_path = os.path.join(DOC, "numisheet93.template.md")
     with open(template_path) as f:
         text = f.read()
@@ -371,17 +431,25 @@ def main():
                 f"{hexa['draw'][qm] - base['draw'][qm]:+.3f}" if qm in hexa["draw"] and qm in base["draw"] else "–"
                 for qm in QUANTITIES)
     element_rows = "\n".join(f"| {label}: F-bar 25 x 25 x 1 instead of solid-shell | {row} |" for label, row in element.items()) or "| (F-bar runs not finished this session) | |"
-    seqs = {label: sequence_of(runs, key) for key, label in MATERIALS}
-    missing = "(a member of the sequence did not finish: `scripts/numisheet93_runs.sh OUT base25 base50 base100`)"
-    for label, seq in seqs.items():
+    # Every sequence of three meshes that can be formed; the finest one gives the answer.
+    candidates = [("ss100", "ss50", "ss25"), ("ss71", "ss50", "ss35"), ("ss50", "ss35", "ss25")]
+    all_seqs = {(label, c): sequence_of(runs, key, c) for key, label in MATERIALS for c in candidates}
+    finest = {}
+    for key, label in MATERIALS:
+        done = [(min(75.0 / dict(MESHES)[m] for m in c), all_seqs[(label, c)]) for c in candidates if all_seqs[(label, c)]]
+        finest[label] = min(done, key=lambda d: d[0])[1] if done else None
+    missing = "(no sequence of three meshes finished: `scripts/numisheet93_runs.sh OUT base35 base50 base71`)"
+    for label, seq in finest.items():
         text = text.replace("{{SEQUENCE_%s}}" % label.upper(),
                             sequence_table(seq, measured, label) if seq else missing)
         text = text.replace("{{THICKNESS_%s}}" % label.upper(), thickness_table(seq) if seq else missing)
-    thickness_svg(seqs, os.path.join(DOC, "numisheet93_thickness.svg"))
+    text = text.replace("{{ORDERS}}", order_check_table(all_seqs))
+    thickness_svg(finest, os.path.join(DOC, "numisheet93_thickness.svg"))
+    svg_chart(runs, measured, finest, os.path.join(DOC, "numisheet93.svg"))
     with open(os.path.join(DOC, "numisheet93_sequence.json"), "w") as f:
-        json.dump({label: None if seq is None else {
-            "h": [h for _, h in SEQUENCE], "extrapolations": seq["result"]} for label, seq in seqs.items()},
-            f, indent=1)
+        json.dump({f"{label} {', '.join(c)}": None if seq is None else {
+            "h": [h for _, _, h in seq["members"]], "extrapolations": seq["result"]}
+            for (label, c), seq in all_seqs.items()}, f, indent=1)
     text = (text.replace("{{COMMIT}}", git_commit())
             .replace("{{RESULTS}}", results_table(runs, measured))
             .replace("{{DIFFERENCES}}", difference_table(runs, measured))
