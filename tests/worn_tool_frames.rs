@@ -101,7 +101,11 @@ fn the_frames_of_a_worn_roller_draw_the_worn_surface() {
     };
     let f = read_vtu(&worn_after).unwrap();
     assert_eq!(f.quads.len(), fields.len());
-    assert_eq!(f.points.len(), 4 * fields.len(), "each cell its own corners");
+    assert_eq!(
+        f.points.len(),
+        4 * fields.len(),
+        "each cell its own corners"
+    );
     let (mut largest, mut checked) = (0.0f64, 0);
     for (c, quad) in f.quads.iter().enumerate() {
         for &p in quad {
@@ -116,7 +120,10 @@ fn the_frames_of_a_worn_roller_draw_the_worn_surface() {
         largest = largest.max(depth[c]);
     }
     println!("{checked} frame points checked, largest applied depth {largest:e}");
-    assert!(largest > 1e-5, "the wear is far above the tolerance: {largest:e}");
+    assert!(
+        largest > 1e-5,
+        "the wear is far above the tolerance: {largest:e}"
+    );
     // Without the option: the exact roller on shared grid nodes.
     let f = read_vtu(&exact_after).unwrap();
     let nodes: usize = fields.grids.iter().map(|g| (g.nu + 1) * (g.nv + 1)).sum();
