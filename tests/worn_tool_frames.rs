@@ -21,7 +21,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use tribo::contact::FrictionLaw;
-use tribo::geometry::{BezierPatch, PatchSurface, RigidSurface, Vec3};
+use tribo::geometry::{BezierPatch, PatchSurface, Vec3};
 use tribo::output::{read_vtu, OutputOptions, RunOutput};
 use tribo::solver::model::strokes::Strokes;
 use tribo::solver::{Model, Simulation};
@@ -62,7 +62,7 @@ fn roller(strokes: Strokes) -> Model {
 /// frame files.
 fn run(strokes: Strokes, out: &Path) -> (Simulation, PathBuf, PathBuf) {
     let mut sim = Simulation::new(roller(strokes)).unwrap();
-    let mut frame = |sim: &Simulation, name: &str| {
+    let frame = |sim: &Simulation, name: &str| {
         let dir = out.join(name);
         let mut output = RunOutput::create(&dir, sim, OutputOptions::default_for(3.0)).unwrap();
         output.write_frame(sim).unwrap();
