@@ -112,6 +112,9 @@ pub struct RunOutput {
     extra: serde_json::Map<String, serde_json::Value>,
     /// Time of each frame written (frame i is frames/frame_{i:04}.vtu).
     frame_times: Vec<f64>,
+    /// Per tool with tool-side fields, its field grid's nodes sampled once for all its
+    /// frames (`tool_fields::GridSamples`: the surface does not change during a run).
+    field_samples: Vec<Option<super::tool_fields::GridSamples>>,
 }
 
 impl RunOutput {
@@ -197,6 +200,7 @@ impl RunOutput {
             history,
             extra: serde_json::Map::new(),
             frame_times: Vec::new(),
+            field_samples: Vec::new(),
         })
     }
 
@@ -354,10 +358,14 @@ impl RunOutput {
         let region = tool_frame::DisplayRegion::around(&sim.model.mesh.nodes);
         for (c, contact) in sim.model.contacts.iter().enumerate() {
             let pose = sim.tool_pose(c);
-            // A tool with tool-side fields is drawn on its field grid, carrying the fields.
+            // A tool with tool-side fields is drawn on its field grid, carrying the fields,
+            // worn when a geometry update of the strokes has worn it.
             let with_fields = (sim.tool_fields(c))
                 .zip(contact.tool.surface.as_patch_surface())
-                .map(|(f, surface)| super::tool_fields::frame(surface, f, &pose));
+                .map(|(fields, surface)| {
+                    let samples = self.field_samples(c, surface, fields);
+                    super::tool_fields::frame_on(samples, fields, &pose, sim.applied_tool_wear(c))
+                });
             if let Some(tool) = with_fields.or_else(|| {
                 tool_frame::tool_frame(&contact.tool, &pose, &region, self.frames.trim_tolerance)
             }) {
@@ -371,6 +379,24 @@ impl RunOutput {
         self.pvd.add_parts(sim.time(), &parts)?;
         self.frame_times.push(sim.time());
         Ok(())
+    }
+
+    /// Tool `c`'s field-grid nodes, sampled at its first frame (or again if its grids
+    /// differ from those sampled).
+    fn field_samples(
+        &mut self,
+        c: usize,
+        surface: &crate::geometry::PatchSurface,
+        fields: &crate::tool::ToolFields,
+    ) -> &super::tool_fields::GridSamples {
+        if self.field_samples.len() <= c {
+            self.field_samples.resize(c + 1, None);
+        }
+        let slot = &mut self.field_samples[c];
+        if !slot.as_ref().is_some_and(|s| s.fits(fields)) {
+            *slot = Some(super::tool_fields::GridSamples::new(surface, fields));
+        }
+        slot.as_ref().expect("sampled above")
     }
 
     /// Writes a frame if the cadence asks for one after increment `index` (or the run has
