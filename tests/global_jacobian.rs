@@ -80,8 +80,8 @@ fn a_slipping_node_on_the_cone_in_plane_strain_leaves_no_empty_column() {
     use tribo::geometry::Plane;
     use tribo::solver::linear::{FaerLu, LinearSolver};
     use tribo::tool::ScalarSchedule;
-    let mesh = tribo::mesh::Mesh::block(Vec3::zeros(), Vec3::new(2.0, 1.0, 1.0), [2, 1, 1])
-        .unwrap();
+    let mesh =
+        tribo::mesh::Mesh::block(Vec3::zeros(), Vec3::new(2.0, 1.0, 1.0), [2, 1, 1]).unwrap();
     let mut model = tribo::solver::Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
     // A holder plane touching the top face (gap 0), its normal towards the block.
     let holder = Plane::new(Vec3::new(0.0, 0.0, 1.0), -Vec3::z()).unwrap();
@@ -103,7 +103,11 @@ fn a_slipping_node_on_the_cone_in_plane_strain_leaves_no_empty_column() {
     let n_u = 3 * sim.model.mesh.nodes.len();
     let candidates = sim.model.contacts[0].candidates.len();
     let mut x = sim.unknowns().to_vec();
-    assert_eq!(x.len(), n_u + 3 * candidates, "displacements, then multipliers");
+    assert_eq!(
+        x.len(),
+        n_u + 3 * candidates,
+        "displacements, then multipliers"
+    );
     // Every candidate pressed with 20 and pulled along x just past mu * 20 (by a relative
     // 1e-15: outside the cone by round-off, as a node that slipped last increment).
     let pressed = 20.0;
@@ -113,14 +117,19 @@ fn a_slipping_node_on_the_cone_in_plane_strain_leaves_no_empty_column() {
     }
     let e = sim.evaluate_at(0.5, &x).unwrap();
     assert!(
-        e.nodal[0].iter().all(|(r, _)| r.status == ContactStatus::Slip),
+        e.nodal[0]
+            .iter()
+            .all(|(r, _)| r.status == ContactStatus::Slip),
         "every candidate slips"
     );
     let scale = e.jacobian.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let column_size = |j: usize| {
         let mut ej = vec![0.0; x.len()];
         ej[j] = 1.0;
-        e.jacobian.mul_vec(&ej).iter().fold(0.0f64, |m, v| m.max(v.abs()))
+        e.jacobian
+            .mul_vec(&ej)
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
     };
     // Every column holds an entry of the matrix's own size (1e-10 of its largest: the
     // element stiffness is ~1e3, the multiplier rows ~1/r; the column found empty before

@@ -553,10 +553,8 @@ mod tests {
     fn tangent_at_reversed_flow_equals_central_differences() {
         let forward = Voigt::new(0.012, -0.005, -0.006, 0.008, 0.001, -0.002);
         let back = |f: f64| forward * f;
-        let cases: [(&[Voigt], Voigt); 2] = [
-            (&[forward], back(0.3)),
-            (&[forward, back(0.7)], back(0.5)),
-        ];
+        let cases: [(&[Voigt], Voigt); 2] =
+            [(&[forward], back(0.3)), (&[forward, back(0.7)], back(0.5))];
         let term_sets: [&[(f64, f64)]; 2] =
             [&[(30e3, 200.0)], &[(30e3, 200.0), (5e3, 20.0), (2e3, 0.0)]];
         for yf in [Hill48::von_mises(), anisotropic()] {
@@ -584,7 +582,17 @@ mod tests {
     #[test]
     fn finite_strain_tangent_at_reversed_flow_equals_central_differences() {
         let stretch = |a: f64| {
-            Mat3::new(1.0 + a, 0.5 * a, 0.0, 0.0, 1.0 - 0.4 * a, 0.1 * a, 0.0, 0.0, 1.0 - 0.5 * a)
+            Mat3::new(
+                1.0 + a,
+                0.5 * a,
+                0.0,
+                0.0,
+                1.0 - 0.4 * a,
+                0.1 * a,
+                0.0,
+                0.0,
+                1.0 - 0.5 * a,
+            )
         };
         for yf in [Hill48::von_mises(), anisotropic()] {
             let m = steel(
