@@ -4,6 +4,7 @@
 
 mod common;
 
+use tribo::geometry::Vec3;
 use tribo::solver::Simulation;
 
 #[test]
@@ -64,4 +65,87 @@ fn check(mut model: tribo::solver::Model) -> Simulation {
         "assembled Jacobian differs from finite differences by {worst:e}"
     );
     sim
+}
+
+/// Issue 47: a node that slipped and has not moved since sits on the Coulomb cone,
+/// `|sigma_t| = mu |sigma_n|`, where the slip law's derivative across the slip direction
+/// vanishes: `dF_suppl_y / dlambda_y = -(1 + mu sigma_n / |sigma_t|) / r = 0`. In plane
+/// strain the multiplier's only other entry lies in the node's y equilibrium row, a
+/// Dirichlet row, so its column was empty and the Jacobian singular (the U-channel's
+/// release with Chaboche hardening stopped there). The component gets the equation
+/// `lambda_y = 0` instead, which is the operator's own solution (`F_equi_y = 0`).
+#[test]
+fn a_slipping_node_on_the_cone_in_plane_strain_leaves_no_empty_column() {
+    use tribo::contact::ContactStatus;
+    use tribo::geometry::Plane;
+    use tribo::solver::linear::{FaerLu, LinearSolver};
+    use tribo::tool::ScalarSchedule;
+    let mesh =
+        tribo::mesh::Mesh::block(Vec3::zeros(), Vec3::new(2.0, 1.0, 1.0), [2, 1, 1]).unwrap();
+    let mut model = tribo::solver::Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
+    // A holder plane touching the top face (gap 0), its normal towards the block.
+    let holder = Plane::new(Vec3::new(0.0, 0.0, 1.0), -Vec3::z()).unwrap();
+    let path = [(0.0, [0.0; 3]), (1.0, [0.0; 3])];
+    let mu = 0.1;
+    model
+        .add_tool(common::tool("holder", holder, &path, mu), "z+", None)
+        .unwrap();
+    model
+        .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    for face in ["y-", "y+"] {
+        model
+            .prescribe(face, "y", ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
+    model.settings.end_time = 1.0;
+    let sim = Simulation::new(model).unwrap();
+    let n_u = 3 * sim.model.mesh.nodes.len();
+    let candidates = sim.model.contacts[0].candidates.len();
+    let mut x = sim.unknowns().to_vec();
+    assert_eq!(
+        x.len(),
+        n_u + 3 * candidates,
+        "displacements, then multipliers"
+    );
+    // Every candidate pressed with 20 and pulled along x just past mu * 20 (by a relative
+    // 1e-15: outside the cone by round-off, as a node that slipped last increment).
+    let pressed = 20.0;
+    for k in 0..candidates {
+        x[n_u + 3 * k] = -mu * pressed * (1.0 + 1e-15);
+        x[n_u + 3 * k + 2] = pressed;
+    }
+    let e = sim.evaluate_at(0.5, &x).unwrap();
+    assert!(
+        e.nodal[0]
+            .iter()
+            .all(|(r, _)| r.status == ContactStatus::Slip),
+        "every candidate slips"
+    );
+    let scale = e.jacobian.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let column_size = |j: usize| {
+        let mut ej = vec![0.0; x.len()];
+        ej[j] = 1.0;
+        e.jacobian
+            .mul_vec(&ej)
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    // Every column holds an entry of the matrix's own size (1e-10 of its largest: the
+    // element stiffness is ~1e3, the multiplier rows ~1/r; the column found empty before
+    // held at most 1e-15/r, round-off of the cone factor).
+    for j in 0..x.len() {
+        assert!(
+            column_size(j) > 1e-10 * scale,
+            "column {j} is empty ({:e} against {scale:e})",
+            column_size(j)
+        );
+    }
+    // The Newton step solves and keeps the y multipliers at zero.
+    let mut dx: Vec<f64> = e.residual.iter().map(|v| -v).collect();
+    FaerLu::default().solve(&e.jacobian, &mut dx).unwrap();
+    assert!(dx.iter().all(|v| v.is_finite()));
+    for k in 0..candidates {
+        assert_eq!(x[n_u + 3 * k + 1] + dx[n_u + 3 * k + 1], 0.0);
+    }
 }

@@ -252,7 +252,8 @@ fn a_release_ramps_the_tools_off_and_restarts_bit_for_bit_inside_it() {
     // the 3-2-1 support's vertical reaction below 1e-6 N once the tools are gone, no node
     // touching a tool. Here: a restart inside the ramp (increment 16 of 13-20) repeats the
     // run bit for bit (the ramp is rebuilt from the committed forces, the supports hold the
-    // committed displacements).
+    // committed displacements), and writes the same springback measures: the loaded shape,
+    // kept when the ramp began, is in the checkpoint.
     const RAMP: &str = "tests/scripts/release_ramp.rhai";
     let tag = std::process::id();
     let full = TestDir::new(&format!("tribo-ramp-full-{tag}"));
@@ -276,6 +277,16 @@ fn a_release_ramps_the_tools_off_and_restarts_bit_for_bit_inside_it() {
         json(&full.join(&end))["state"],
         json(&out.join(&end))["state"],
         "final state after a restart inside the release"
+    );
+    let springback = &summary["springback"];
+    assert!(
+        springback.as_array().is_some_and(|s| s.len() == 1),
+        "the uninterrupted run measures the lift-off's springback: {springback}"
+    );
+    assert_eq!(
+        &json(&out.join("summary.json"))["springback"],
+        springback,
+        "springback after a restart inside the release"
     );
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&full);
@@ -403,8 +414,26 @@ fn the_u_channel_springs_open_once_released() {
     // support's reaction at round-off (it fails the run otherwise). Here what summary.json
     // says of the springback (isotropic hardening; measured: theta1 98.56 -> 100.90
     // degrees, the wall's radius 3027 -> 254 mm).
-    let out = TestDir::new(&format!("tribo-uc-springback-{}", std::process::id()));
-    run_script("scripts/u_channel_springback.rhai", &out, None, &[]);
+    u_channel_springs_open(&[]);
+}
+
+/// Issue 47: with Chaboche kinematic hardening (one Armstrong-Frederick term) the release
+/// used to stop at its first increment on a singular Jacobian (a slipping holder node on
+/// the Coulomb cone, `assembly::multiplier_unit_rows`). It now releases under the same
+/// checks; physics says only that the channel opens here too (by how much more than with
+/// isotropic hardening is measured in docs/u-channel-springback.md, not asserted).
+#[test]
+fn the_u_channel_with_kinematic_hardening_releases_and_springs_open() {
+    let angles = u_channel_springs_open(&["kinematic=true"]);
+    assert_eq!(angles["kinematic"], true, "{angles}");
+}
+
+/// Runs the U-channel springback script with `sets` and checks what summary.json says of
+/// the springback; returns its `springback_angles`.
+fn u_channel_springs_open(sets: &[&str]) -> serde_json::Value {
+    let tag = format!("{}-{}", std::process::id(), sets.len());
+    let out = TestDir::new(&format!("tribo-uc-springback-{tag}"));
+    run_script("scripts/u_channel_springback.rhai", &out, None, sets);
     let summary = json(&out.join("summary.json"));
     let angles = &summary["springback_angles"];
     let (before, after) = (
@@ -434,5 +463,7 @@ fn the_u_channel_springs_open_once_released() {
     let rms = springback[0]["rms_displacement"].as_f64().unwrap();
     assert!(max > 0.1 && max < 20.0, "{max}");
     assert!(rms > 0.0 && rms < max, "{rms} {max}");
+    println!("{sets:?}: springback_angles {angles}, springback {springback:?}");
     let _ = std::fs::remove_dir_all(&out);
+    angles.clone()
 }

@@ -493,11 +493,23 @@ mod tests {
     /// truncation ~1e-14 relative, round-off ~1e-16 x 1e3 MPa / 1e-7 ~ 1e-6 MPa on entries
     /// ~1e5 MPa; 1e-6 relative to the largest entry is a real check).
     fn check_small_strain_tangent(m: &ElastoPlastic, eps: Voigt) {
-        let mut committed = m.initial_state();
-        for history in [
+        let history = [
             Voigt::new(0.01, -0.004, -0.003, 0.006, -0.002, 0.003),
             Voigt::new(-0.002, 0.003, -0.003, -0.004, 0.001, 0.0),
-        ] {
+        ];
+        check_tangent_after(m, &history, eps);
+    }
+
+    /// The committed state reached through the strains `history` (one increment each),
+    /// then the tangent at `eps` against central differences (tolerance as
+    /// `check_small_strain_tangent`'s). Returns the committed and the trial state.
+    fn check_tangent_after(
+        m: &ElastoPlastic,
+        history: &[Voigt],
+        eps: Voigt,
+    ) -> (PointState, PointState) {
+        let mut committed = m.initial_state();
+        for &history in history {
             let mut next = committed;
             m.update(&Kinematics::from_strain(history), &committed, &mut next)
                 .unwrap();
@@ -527,6 +539,100 @@ mod tests {
         assert!((d - m.elastic_tangent()).amax() > 1e-3 * d.amax());
         let sy = m.hardening().yield_stress(trial.eq_plastic_strain);
         assert!(m.yield_value(&trial).abs() < 1e-9 * sy);
+        (committed, trial)
+    }
+
+    /// Reversed flow (issue 47: the release after bending over a die radius): strained
+    /// in tension with shear, then back, so that the trial's plastic strain increment
+    /// points against the committed back stress (`dεp . X < 0`, checked). Once with the
+    /// reversal inside the trial increment (elastic unloading, then reverse yielding on the
+    /// shifted surface) and once after a committed increment back (the back stress not yet
+    /// turned: the reversal is small against the saturation strain 1/γ). Every
+    /// isotropic law, von Mises and Hill48, one to three terms.
+    #[test]
+    fn tangent_at_reversed_flow_equals_central_differences() {
+        let forward = Voigt::new(0.012, -0.005, -0.006, 0.008, 0.001, -0.002);
+        let back = |f: f64| forward * f;
+        let cases: [(&[Voigt], Voigt); 2] =
+            [(&[forward], back(0.3)), (&[forward, back(0.7)], back(0.5))];
+        let term_sets: [&[(f64, f64)]; 2] =
+            [&[(30e3, 200.0)], &[(30e3, 200.0), (5e3, 20.0), (2e3, 0.0)]];
+        for yf in [Hill48::von_mises(), anisotropic()] {
+            for law in laws() {
+                for terms in term_sets {
+                    let m = steel(law.clone(), yf, terms);
+                    for (history, eps) in cases {
+                        let (committed, trial) = check_tangent_after(&m, history, eps);
+                        let dep = trial.plastic_strain - committed.plastic_strain;
+                        let x = committed.total_back_stress();
+                        assert!(
+                            dep.dot(&x) < -1e-3 * dep.norm() * x.norm(),
+                            "{}: the flow is not reversed",
+                            m.describe()
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// The same at finite strain (log-strain extension): a stretch with shear, then
+    /// partly back, the tangent `dS/dE_GL` against central differences of `S(C)` as in
+    /// `finite_strain_tangent_equals_central_differences`.
+    #[test]
+    fn finite_strain_tangent_at_reversed_flow_equals_central_differences() {
+        let stretch = |a: f64| {
+            Mat3::new(
+                1.0 + a,
+                0.5 * a,
+                0.0,
+                0.0,
+                1.0 - 0.4 * a,
+                0.1 * a,
+                0.0,
+                0.0,
+                1.0 - 0.5 * a,
+            )
+        };
+        for yf in [Hill48::von_mises(), anisotropic()] {
+            let m = steel(
+                Hardening::swift(500.0, 0.01, 0.22).unwrap(),
+                yf,
+                &[(30e3, 200.0), (5e3, 20.0)],
+            );
+            let mut committed = PointState::default();
+            for g in [stretch(0.02), stretch(0.016)] {
+                let mut t = committed;
+                m.update_finite(&g, &committed, &mut t).unwrap();
+                committed = t;
+            }
+            let f = stretch(0.012);
+            let mut trial = committed;
+            let resp = m.update_finite(&f, &committed, &mut trial).unwrap();
+            let dep = trial.plastic_strain - committed.plastic_strain;
+            let x = committed.total_back_stress();
+            assert!(trial.eq_plastic_strain > committed.eq_plastic_strain);
+            assert!(dep.dot(&x) < -1e-3 * dep.norm() * x.norm(), "flow reversed");
+            let c = f.transpose() * f;
+            let h = 1e-7;
+            let scale = resp.tangent.amax();
+            let s_at = |c: &Mat3| {
+                let e = SymmetricEigen::new(*c);
+                let u = e.eigenvectors
+                    * Mat3::from_diagonal(&e.eigenvalues.map(f64::sqrt))
+                    * e.eigenvectors.transpose();
+                let mut t = committed;
+                m.update_finite(&u, &committed, &mut t).unwrap().pk2
+            };
+            for n in 0..6 {
+                let mut e = Voigt::zeros();
+                e[n] = h;
+                let dc = strain_to_tensor(&e) * 2.0;
+                let fd = (s_at(&(c + dc)) - s_at(&(c - dc))) / (2.0 * h);
+                let err = (fd - resp.tangent.column(n)).amax() / scale;
+                assert!(err < 1e-6, "{}: column {n}: {err:e}", yf.describe());
+            }
+        }
     }
 
     fn laws() -> Vec<Hardening> {

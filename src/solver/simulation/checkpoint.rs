@@ -7,6 +7,7 @@
 //! flips, mu), the time, the increment counter, the step controller (next increment size),
 //! the energy balance and the forces of the trapezoidal energy rule, what the elements
 //! remember of their last linearisation (where the solid-shell's next local solves start),
+//! the loaded shape and springback measures of release steps (`simulation::springback`),
 //! and the increment reports so far. The model itself (mesh, materials, tools, schedules, settings) is not
 //! stored: the script builds it again, and [`Checkpoint::restore`] checks that it matches
 //! (sizes, tool names and candidates, tool positions at the checkpoint's time).
@@ -74,6 +75,16 @@ pub struct SavedState {
     /// this stroke took it; left out when no tool is worn (older checkpoints: none).
     #[serde(default, skip_serializing_if = "no_frozen_work")]
     pub tool_wear_applied: Vec<Option<Vec<f64>>>,
+    /// The node positions where loading ended, once a release step has begun
+    /// (`simulation::springback`), so that a run restarted after it measures springback
+    /// as the uninterrupted one; left out before (older checkpoints: none, and a run
+    /// restarted inside its release then reports no springback).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loaded_shape: Option<Vec<crate::geometry::Vec3>>,
+    /// The springback of the release steps completed; left out when none (older
+    /// checkpoints: none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub springback: Vec<crate::solver::simulation::springback::Springback>,
 }
 
 fn is_zero(k: &usize) -> bool {

@@ -124,7 +124,7 @@ pub struct Simulation {
     /// a ramp-off step rewrote them (`release`).
     pub(super) base_forces: Vec<Option<crate::tool::ScalarSchedule>>,
     /// The node positions where loading ended, kept for the springback measures
-    /// (`springback`); not in checkpoints.
+    /// (`springback`); in checkpoints once kept.
     pub(super) loaded_shape: Option<Vec<Vec3>>,
     /// The springback of each release step completed (`springback`).
     pub(super) springback: Vec<springback::Springback>,
@@ -797,6 +797,8 @@ impl Simulation {
             stroke: self.stroke,
             tool_work_frozen: self.tool_work_frozen.clone(),
             tool_wear_applied: self.tool_wear_applied.clone(),
+            loaded_shape: self.loaded_shape.clone(),
+            springback: self.springback.clone(),
         }
     }
 
@@ -841,6 +843,8 @@ impl Simulation {
             vec![None; self.tool_wear_applied.len()]
         };
         self.set_worn_tools();
+        self.loaded_shape = state.loaded_shape;
+        self.springback = state.springback;
     }
 
     /// The tool-side fields of tool `c`, if it accumulates them (`Tool::fields`).

@@ -14,15 +14,17 @@
 //!
 //! (`d` keeps `R` a rotation, not a reflection). The springback displacement of node `i` is
 //! `e_i = b_i - (R a_i + t)`; the measures are `max_i |e_i|` and `sqrt(mean_i |e_i|^2)`,
-//! lengths in the mesh's units. A run restarted from a checkpoint after loading ended has
-//! no loaded shape (it is not part of the checkpoint) and reports no measures.
+//! lengths in the mesh's units. The loaded shape and the measures so far are part of the
+//! committed state (checkpoints and rollback), so a run restarted after loading ended
+//! reports the measures of the uninterrupted run; one restarted from an older checkpoint
+//! without them reports none.
 
 use crate::geometry::{Mat3, Vec3};
 use crate::solver::model::steps;
 use crate::solver::simulation::Simulation;
 
 /// The springback of one release step.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Springback {
     /// The release step (index into `Model::steps`).
     pub step: usize,
