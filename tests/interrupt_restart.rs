@@ -181,3 +181,72 @@ fn a_signal_stops_the_cup_and_restart_reproduces_the_uninterrupted_run() {
     }
     let _ = std::fs::remove_dir_all(&full);
 }
+
+/// Issue 52: a signal while the script runs its own code (here a loop after two increments)
+/// stopped nothing: the flag was polled only between increments, so the loop ran to the
+/// script time limit (600 s) and a `timeout` killed the run without summary or checkpoint,
+/// leaving the lock. The script's progress callback now polls it too.
+#[test]
+fn a_signal_stops_a_script_busy_in_its_own_code() {
+    use std::io::BufRead;
+    let dir = fresh_dir("busy");
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("busy.rhai");
+    // Each pass of the loop builds a mesh (milliseconds for one script operation), so that
+    // neither the operation limit nor the memory limit ends it before the script time limit.
+    std::fs::write(
+        &script,
+        "let mesh = block([0, 0, 0], [1, 1, 1], [2, 2, 2]);\n\
+         let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n\
+         sim.fix(\"z-\", \"xyz\");\n\
+         sim.prescribe(\"z+\", \"z\", [[0.0, 0.0], [1.0, -0.01]]);\n\
+         sim.settings(#{ end_time: 1.0, increments: 4 });\n\
+         sim.step();\nsim.step();\nprint(\"looping\");\n\
+         loop { let m = block([0, 0, 0], [1, 1, 1], [20, 20, 20]); }\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let mut child = Command::new(BIN)
+        .arg("run")
+        .arg(&script)
+        .arg("--out")
+        .arg(&out)
+        .args(["--quiet", "--max-script-seconds", "600"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start tribo");
+    let mut line = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    assert_eq!(line.trim(), "looping");
+    let sent = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(sent.success());
+    // The poll is every 64 script operations (a few loop passes, well under a second); 60 s
+    // is a bound for a loaded machine, far below the 600 s the loop ran before.
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("the script loop did not stop within 60 s of SIGTERM");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
+    assert_eq!(status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted: SIGTERM received"), "{stderr}");
+    let stopped = summary(&out);
+    assert_eq!(stopped["status"], "interrupted");
+    assert_eq!(stopped["increments"], 2);
+    assert!(out.join("checkpoints/final.json").is_file(), "final checkpoint");
+    assert!(!out.join(".tribo.lock").exists(), "the lock is released");
+    let _ = std::fs::remove_dir_all(&dir);
+}
