@@ -137,7 +137,7 @@ pub fn crawl_message(dt_min: f64, increments: usize, time: f64, end_time: f64) -
          (setting dt_min) reached t = {time:.6e} of end_time = {end_time}, and the rest would take up \
          to {} more; stopped (the rule: {CRAWL_INCREMENTS} increments in a row held at dt_min by an \
          exceeded limit or a cutback). Look at the last state (checkpoints/final.json, the column \
-         limit of history.csv) for what holds the step back; raise dt_min to go on in coarser steps",
+         step_limit of history.csv) for what holds the step back; raise dt_min to go on in coarser steps",
         ((end_time - time) / dt_min).ceil().max(0.0)
     )
 }
