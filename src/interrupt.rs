@@ -5,16 +5,24 @@
 //! The flag is a handle, not a process global, so that runs inside one process (tests, the
 //! studies) do not interrupt each other; `tribo run` and `tribo repl` connect the handle of
 //! their run to the process's signals with [`Interrupt::install_signal_handlers`]. A second
-//! signal while the flag is still raised ends the process at once (exit status 130), for a
-//! run that does not reach its next poll soon enough.
+//! signal while the flag is still raised, more than [`REPEAT_WINDOW_NS`] after the first,
+//! ends the process at once (exit status 130), for a run that does not reach its next poll
+//! soon enough. One sooner is taken as the same request: GNU `timeout` sends its signal to
+//! the run and then to its whole process group, so the run receives it twice within
+//! microseconds, and exiting on the second lost the summary, the final checkpoint and the
+//! folder's lock (issue 52).
 //!
 //! Polling costs one relaxed atomic load.
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// Exit status of a run stopped by a signal (128 + SIGINT, the shell's convention).
 pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// A repeated signal this soon after the first (1 s, in nanoseconds) is the same request.
+/// A person pressing Ctrl-C twice to force the stop takes longer than that.
+pub const REPEAT_WINDOW_NS: u64 = 1_000_000_000;
 
 /// Shared stop request; clones see the same flag.
 #[derive(Clone, Debug, Default)]
@@ -22,6 +30,19 @@ pub struct Interrupt {
     raised: Arc<AtomicBool>,
     /// The signal number that raised the flag (0: raised by a caller).
     signal: Arc<AtomicUsize>,
+    /// When the flag was raised (CLOCK_MONOTONIC, nanoseconds).
+    raised_at: Arc<AtomicU64>,
+}
+
+/// CLOCK_MONOTONIC in nanoseconds (`clock_gettime` is async-signal-safe, so the handler
+/// may call it).
+fn monotonic_ns() -> u64 {
+    // SAFETY: clock_gettime writes into the zeroed struct it is given and has no other effect.
+    let mut ts: libc::timespec = unsafe { std::mem::zeroed() };
+    unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
+    (ts.tv_sec.max(0) as u64)
+        .saturating_mul(1_000_000_000)
+        .saturating_add(ts.tv_nsec.max(0) as u64)
 }
 
 impl Interrupt {
@@ -36,6 +57,7 @@ impl Interrupt {
 
     /// Requests a stop as if `signal` had arrived (0: no signal, a caller's request).
     pub fn raise(&self, signal: usize) {
+        self.raised_at.store(monotonic_ns(), Ordering::SeqCst);
         self.signal.store(signal, Ordering::SeqCst);
         self.raised.store(true, Ordering::SeqCst);
     }
@@ -57,22 +79,32 @@ impl Interrupt {
     }
 
     /// Connects SIGINT and SIGTERM to this flag for the rest of the process: the first
-    /// raises it, a second one while it is raised exits at once with status 130.
+    /// raises it; a second one while it is raised exits at once with status 130, unless it
+    /// comes within [`REPEAT_WINDOW_NS`] of the first (the same request delivered twice).
     pub fn install_signal_handlers(&self) -> crate::Result<()> {
-        use signal_hook::flag;
         for sig in [SIGINT, SIGTERM] {
-            let fail = |e: std::io::Error| {
-                crate::Error::Input(format!("cannot install the handler of signal {sig}: {e}"))
-            };
-            // Registered first, so it sees the flag as it was before this signal.
-            flag::register_conditional_shutdown(
-                sig,
-                i32::from(EXIT_INTERRUPTED),
+            let (raised, signal, at) = (
                 self.raised.clone(),
-            )
-            .map_err(fail)?;
-            flag::register_usize(sig, self.signal.clone(), sig as usize).map_err(fail)?;
-            flag::register(sig, self.raised.clone()).map_err(fail)?;
+                self.signal.clone(),
+                self.raised_at.clone(),
+            );
+            // Only atomics, clock_gettime and _exit: all async-signal-safe.
+            let handler = move || {
+                let now = monotonic_ns();
+                if raised.load(Ordering::SeqCst) {
+                    if now.saturating_sub(at.load(Ordering::SeqCst)) > REPEAT_WINDOW_NS {
+                        signal_hook::low_level::exit(i32::from(EXIT_INTERRUPTED));
+                    }
+                    return;
+                }
+                at.store(now, Ordering::SeqCst);
+                signal.store(sig as usize, Ordering::SeqCst);
+                raised.store(true, Ordering::SeqCst);
+            };
+            // SAFETY: the handler does only async-signal-safe work (see above).
+            unsafe { signal_hook::low_level::register(sig, handler) }.map_err(|e| {
+                crate::Error::Input(format!("cannot install the handler of signal {sig}: {e}"))
+            })?;
         }
         Ok(())
     }

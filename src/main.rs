@@ -266,6 +266,12 @@ struct Limits {
     /// Bytes the run may write into its output folder, in MiB.
     #[arg(long = "max-output-mb", value_name = "MIB", default_value_t = 20_480)]
     max_output_mb: u64,
+    /// Entries one script array may hold (nested arrays counted).
+    #[arg(long = "max-array-size", value_name = "N", default_value_t = tribo::script::limits::DEFAULT_MAX_ARRAY)]
+    max_array_size: usize,
+    /// Entries the maps of one script value may hold (nested maps counted).
+    #[arg(long = "max-map-size", value_name = "N", default_value_t = tribo::script::limits::DEFAULT_MAX_MAP)]
+    max_map_size: usize,
 }
 
 impl Limits {
@@ -279,6 +285,8 @@ impl Limits {
         l.max_script_time = std::time::Duration::from_secs(self.max_script_seconds);
         l.max_increments = self.max_increments;
         l.max_output = self.max_output_mb.saturating_mul(1 << 20);
+        l.max_array = self.max_array_size;
+        l.max_map = self.max_map_size;
         tribo::paths::set_output_limit(l.max_output);
     }
 }

@@ -123,6 +123,10 @@ static LEDGERS: Mutex<BTreeMap<PathBuf, Ledger>> = Mutex::new(BTreeMap::new());
 /// [`resolve_write`] when it hands out the next path: files written since the last call (and
 /// files still growing, like history.csv) are measured, so the run stops at the first write
 /// after the cap, with at most one file's worth written over it.
+///
+/// The stop's own record ([`STOP_RECORD`]: summary.json, checkpoints/final.json) is written
+/// past the cap: without it a run stopped by the cap would neither say why nor be able to
+/// continue. Each is one file rewritten in place, so the excess stays bounded by their size.
 pub fn set_output_limit(bytes: u64) {
     OUTPUT_LIMIT.store(bytes, Ordering::Relaxed);
 }
@@ -130,6 +134,9 @@ pub fn set_output_limit(bytes: u64) {
 /// Measures the files written since the last call and refuses a new write once over the cap.
 /// Cost: one `lstat` per file written or grown since the last call (a file that stays the
 /// same size for 8 calls is no longer watched).
+/// The files a stopped run writes whatever its output size ([`set_output_limit`]).
+pub const STOP_RECORD: [&str; 2] = ["summary.json", "checkpoints/final.json"];
+
 fn charge_output(root: &Path, next: &Path) -> Result<()> {
     let limit = OUTPUT_LIMIT.load(Ordering::Relaxed);
     let mut ledgers = LEDGERS.lock().unwrap_or_else(|e| e.into_inner());
@@ -143,7 +150,8 @@ fn charge_output(root: &Path, next: &Path) -> Result<()> {
         *same < 8
     });
     ledger.watch = watch;
-    if ledger.total > limit {
+    let stop_record = STOP_RECORD.iter().any(|f| next == root.join(f));
+    if ledger.total > limit && !stop_record {
         return Err(Error::Input(format!(
             "the run has written {} bytes into its output folder {}, over the limit of {} bytes \
              (raise it with --max-output-mb)",

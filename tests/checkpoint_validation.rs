@@ -80,6 +80,11 @@ fn tampered_values_are_refused_naming_the_field() {
             "state.controller.dt = 0".to_string(),
         ),
         (
+            "huge multiplier",
+            Box::new(move |j: &mut Value| j["state"]["contact"][0][k]["lambda"][2] = 1e300.into()),
+            format!("state.contact[0][{k}].lambda[2] = 1000000000000000000000000000000"),
+        ),
+        (
             "wrong mesh fingerprint",
             Box::new(|j: &mut Value| j["model"]["mesh_hash"] = "0123456789abcdef".into()),
             "model.mesh_hash".to_string(),
@@ -167,4 +172,39 @@ sim.run();
     assert!(live.exists() && other.exists(), "other files stay");
     assert!(dir.join("out/checkpoints/checkpoint_0002.json").is_file());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 52: a checkpoint restored into a model with another material or another friction
+/// law was accepted (only the mesh and the tools' surfaces were fingerprinted).
+#[test]
+fn a_checkpoint_of_another_material_or_friction_law_is_refused() {
+    let json = checkpoint_json();
+    let restore_into = |model: tribo::solver::Model| {
+        let mut sim = Simulation::new(model).unwrap();
+        Checkpoint::from_json(&json.to_string(), "other.json")
+            .unwrap()
+            .restore(&mut sim)
+            .map_err(|e| e.to_string())
+    };
+    let mut stiffer = model();
+    stiffer.material = common::elastic(2000.0, 0.3);
+    let err = restore_into(stiffer).unwrap_err();
+    assert!(err.contains("model.material_hash") && err.contains("2000"), "{err}");
+    let mut rougher = model();
+    rougher.contacts[0].tool.friction = tribo::contact::FrictionLaw::coulomb(0.3).unwrap();
+    let err = restore_into(rougher).unwrap_err();
+    assert!(
+        err.contains("model.friction_hashes[0]") && err.contains("mu = 0.3"),
+        "{err}"
+    );
+    // An old checkpoint without these fingerprints is still read (sizes and names checked).
+    let mut old = json.clone();
+    let fingerprint = old["model"].as_object_mut().unwrap();
+    fingerprint.remove("material_hash");
+    fingerprint.remove("friction_hashes");
+    let mut sim = Simulation::new(model()).unwrap();
+    Checkpoint::from_json(&old.to_string(), "old.json")
+        .unwrap()
+        .restore(&mut sim)
+        .unwrap();
 }

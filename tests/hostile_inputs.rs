@@ -181,3 +181,81 @@ fn a_script_with_a_byte_order_mark_runs() {
     let (code, err) = run("bom", "\u{feff}let x = 1;\nassert(x == 1, \"x\");\n", &[]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// A body that nothing holds "finished" with 0 Newton iterations and an energy error of 1:
+/// now refused at the start of the run, naming the free directions and the fix.
+#[test]
+fn a_body_free_to_move_is_refused_naming_its_free_directions() {
+    let head = "let mesh = block([0, 0, 0], [1, 1, 1], [1, 1, 1]);\n\
+                let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n\
+                sim.load(\"z+\", [0.0, 0.0, -1.0], [[0.0, 0.0], [1.0, 1.0]]);\n";
+    let (code, err) = run("free", &format!("{head}sim.run();\n"), &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("free to move as a rigid body") && err.contains("free.rhai:4:"),
+        "{err}"
+    );
+    for direction in ["x", "y", "z"] {
+        assert!(err.contains(&format!("translation {direction}")), "{err}");
+        assert!(err.contains(&format!("rotation about {direction}")), "{err}");
+    }
+    assert!(err.contains("sim.fix") && err.contains("sim.add_tool"), "{err}");
+    // Held in z on its bottom face: free in x, y and about z only, and so named.
+    let (code, err) = run(
+        "partial",
+        &format!("{head}sim.fix(\"z-\", \"z\");\nsim.run();\n"),
+        &[],
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("translation x, translation y, rotation about z")
+            && !err.contains("translation z")
+            && !err.contains("rotation about x"),
+        "{err}"
+    );
+    // Supported: runs.
+    let (code, err) = run(
+        "held",
+        &format!("{head}sim.fix(\"z-\", \"xyz\");\nsim.run();\n"),
+        &[],
+    );
+    assert_eq!(code, 0, "{err}");
+}
+
+/// A run held at the minimum step crawled for hours: it now stops after
+/// `CRAWL_INCREMENTS` (100) increments in a row held at dt_min, with the reason, keeping
+/// summary.json and the final checkpoint. Here a slip limit of 1e-9 per increment that a
+/// block dragged at speed 1 exceeds even at dt_min = 1e-6.
+#[test]
+fn a_run_crawling_at_the_minimum_step_stops_with_the_reason() {
+    let src = "let mesh = block([0, 0, 0], [1, 1, 1], [1, 1, 1]);\n\
+               let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n\
+               sim.add_tool(tool(\"plate\", plane([0, 0, 0], [0, 0, 1])).friction(coulomb(0.1)), \"z-\");\n\
+               sim.load(\"z+\", [0.0, 0.0, -10.0], [[0.0, 0.0], [1.0, 1.0]]);\n\
+               sim.prescribe(\"z+\", \"x\", [[0.0, 0.0], [1.0, 1.0]]);\n\
+               sim.fix(\"z+\", \"y\");\n\
+               sim.settings(#{ step_control: \"adaptive\", max_slip_increment: 1e-9 });\n\
+               sim.run();\n";
+    // Before the rule the run went on to the --max-increments cap (set low here so that the
+    // old behaviour fails in seconds rather than crawling 10^6 increments).
+    let (code, err, dir) = common::run_script_in("hostile", "crawl", src, &["--max-increments", "2000"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("the run crawls at the minimum step: 100 increments in a row at dt_min = 1e-6")
+            && err.contains("(setting dt_min)")
+            && err.contains("reached t = "),
+        "{err}"
+    );
+    let out = dir.join("out");
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(summary["status"], "stopped");
+    assert!(
+        summary["stop_reason"].as_str().unwrap().contains("crawls at the minimum step"),
+        "{}",
+        summary["stop_reason"]
+    );
+    let increments = summary["increments"].as_u64().unwrap();
+    assert!((100..2000).contains(&increments), "{increments} increments");
+    assert!(out.join("checkpoints/final.json").is_file(), "final checkpoint");
+}

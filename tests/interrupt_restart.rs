@@ -181,3 +181,112 @@ fn a_signal_stops_the_cup_and_restart_reproduces_the_uninterrupted_run() {
     }
     let _ = std::fs::remove_dir_all(&full);
 }
+
+/// A run of two increments that then loops in its own script code, started and read up to
+/// its "looping" line; returns the child and its output folder. Each pass of the loop
+/// builds a mesh of `cells`^3 cells (milliseconds for one script operation), so that
+/// neither the operation limit nor the memory limit ends it before the script time limit
+/// (600 s).
+fn start_busy_script(tag: &str, cells: usize) -> (Child, PathBuf, PathBuf) {
+    use std::io::BufRead;
+    let dir = fresh_dir(tag);
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("busy.rhai");
+    std::fs::write(
+        &script,
+        "let mesh = block([0, 0, 0], [1, 1, 1], [2, 2, 2]);\n\
+         let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n\
+         sim.fix(\"z-\", \"xyz\");\n\
+         sim.prescribe(\"z+\", \"z\", [[0.0, 0.0], [1.0, -0.01]]);\n\
+         sim.settings(#{ end_time: 1.0, increments: 4 });\n\
+         sim.step();\nsim.step();\nprint(\"looping\");\n\
+         loop { let m = block([0, 0, 0], [1, 1, 1], [CELLS, CELLS, CELLS]); }\n"
+            .replace("CELLS", &cells.to_string()),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let mut child = Command::new(BIN)
+        .arg("run")
+        .arg(&script)
+        .arg("--out")
+        .arg(&out)
+        // The memory bound raised past the estimate of 100 KB per node of a simulated mesh:
+        // these meshes are built and dropped, never simulated (about 100 bytes a node).
+        .args(["--quiet", "--max-script-seconds", "600", "--max-memory-mb", "1000000"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start tribo");
+    let mut line = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    assert_eq!(line.trim(), "looping");
+    (child, out, dir)
+}
+
+/// Waits for the busy script to stop after its signal(s) and checks the interrupted run's
+/// record: exit 130, summary "interrupted" after its 2 increments, the final checkpoint,
+/// the lock released.
+fn assert_busy_script_interrupted(mut child: Child, out: &Path, dir: &Path) {
+    // The poll is every 64 script operations (a few loop passes, well under a second); 60 s
+    // is a bound for a loaded machine, far below the 600 s the loop ran before.
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("the script loop did not stop within 60 s of SIGTERM");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
+    assert_eq!(status.code(), Some(130), "{stderr}");
+    assert!(out.join("summary.json").is_file(), "summary.json: {stderr}");
+    assert!(stderr.contains("interrupted: SIGTERM received"), "{stderr}");
+    let stopped = summary(out);
+    assert_eq!(stopped["status"], "interrupted");
+    assert_eq!(stopped["increments"], 2);
+    assert!(out.join("checkpoints/final.json").is_file(), "final checkpoint");
+    assert!(!out.join(".tribo.lock").exists(), "the lock is released");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Issue 52: a signal while the script runs its own code (here a loop after two increments)
+/// stopped nothing: the flag was polled only between increments, so the loop ran to the
+/// script time limit (600 s) and a `timeout` killed the run without summary or checkpoint,
+/// leaving the lock. The script's progress callback now polls it too.
+#[test]
+fn a_signal_stops_a_script_busy_in_its_own_code() {
+    let (child, out, dir) = start_busy_script("busy", 20);
+    let sent = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(sent.success());
+    assert_busy_script_interrupted(child, &out, &dir);
+}
+
+/// Issue 52: GNU `timeout` sends SIGTERM to the run and then to its whole process group, so
+/// the run can get it twice, the second after its handler took the first; that second was
+/// taken as "stop now" (exit 130 at once: no summary, no checkpoint, the lock left; 1 of 3
+/// runs of a script friction law under `timeout 2` on the 2-core machine). A signal within
+/// a second of the first is now the same request. Here the second comes 50 ms after the
+/// first, while the script is still building its 60^3 mesh (about 60 ms a pass, and the
+/// stop request is polled every 64 operations, about 13 passes): the run is surely still
+/// going when it arrives.
+#[test]
+fn a_repeated_signal_within_a_second_is_the_same_request() {
+    let (child, out, dir) = start_busy_script("twice", 60);
+    let pid = child.id() as libc::pid_t;
+    // SAFETY: plain kill(2) on our own child (not reaped before the checks below).
+    unsafe {
+        assert_eq!(libc::kill(pid, libc::SIGTERM), 0);
+        std::thread::sleep(Duration::from_millis(50));
+        assert_eq!(libc::kill(pid, libc::SIGTERM), 0);
+    }
+    assert_busy_script_interrupted(child, &out, &dir);
+}

@@ -108,7 +108,13 @@ fn script_memory_is_bounded() {
     // 60 nested calls each holding a 4 Mi-element array (~4 GB if unbounded).
     let src =
         "fn f(n) { let a = []; a.pad(4000000, 1.0); if n > 0 { f(n - 1) } else { 0 } }\nf(60);\n";
-    let o = run("recursion", src, &["--max-memory-mb", "400"]);
+    // The array bound raised to 4 Mi entries (the bound this test was written for), so that
+    // the memory limit, not the array size, stops it.
+    let o = run(
+        "recursion",
+        src,
+        &["--max-memory-mb", "400", "--max-array-size", "4194304"],
+    );
     assert_eq!(o.code, 1);
     assert!(
         o.stderr
@@ -131,12 +137,12 @@ fn endless_loops_stop_with_the_limit_message() {
     );
     assert!(o.wall < Duration::from_secs(60), "{:?}", o.wall);
 
-    // Each push re-measures the array (quadratic): the operation count alone would take
-    // hours; the script-time limit stops it.
+    // Each push re-measures the array (quadratic): with the array bound raised to 4 Mi
+    // entries the operation count alone would take hours; the script-time limit stops it.
     let o = run(
         "push",
         "let a = [];\nloop { a.push(1); }\n",
-        &["--max-script-seconds", "2"],
+        &["--max-script-seconds", "2", "--max-array-size", "4194304"],
     );
     assert_eq!(o.code, 1);
     assert!(
@@ -147,6 +153,55 @@ fn endless_loops_stop_with_the_limit_message() {
         o.stderr
     );
     assert!(o.wall < Duration::from_secs(30), "{:?}", o.wall);
+}
+
+#[test]
+fn a_growing_array_stops_at_its_bound_naming_the_option() {
+    // Issue 52: with the old bound (4 Mi entries) this loop ran to the 600 s script limit
+    // (each push counts the whole array). The script-time limit is set to 60 s so that the
+    // old behaviour fails here with that limit's message rather than after 10 minutes; the
+    // default bound (65 536) is reached in about 4 s on the 2-core test machine.
+    let o = run(
+        "array",
+        "let a = [];\nloop { a.push(1); }\n",
+        &["--max-script-seconds", "60"],
+    );
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("s.rhai:2:")
+            && o.stderr.contains("more than 65 536 entries")
+            && o.stderr.contains("--max-array-size"),
+        "{}",
+        o.stderr
+    );
+    // The bound is the user's: a lower one stops a loop that builds more, and a script
+    // within it runs.
+    let o = run(
+        "array-low",
+        "let a = [];\nfor i in 0..2000 { a.push(i); }\n",
+        &["--max-array-size", "1000"],
+    );
+    assert!(o.stderr.contains("more than 1 000 entries"), "{}", o.stderr);
+    let o = run(
+        "array-ok",
+        "let a = [];\nfor i in 0..2000 { a.push(i); }\n",
+        &[],
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    // Maps: an entry set by a call is checked against --max-map-size (Rhai checks a map
+    // assigned by index, `m[key] = v`, for the value only; such growth is bounded by the
+    // operation and memory limits).
+    let o = run(
+        "map-low",
+        "let m = #{};\nfor i in 0..2000 { m.set(`k${i}`, i); }\n",
+        &["--max-map-size", "1000"],
+    );
+    assert!(
+        o.stderr.contains("more than 1 000 entries in one value")
+            && o.stderr.contains("--max-map-size"),
+        "{}",
+        o.stderr
+    );
 }
 
 const SCENE: &str = r#"
@@ -256,4 +311,28 @@ fn output_size_is_capped() {
         written <= (8 << 20) + (512 << 10),
         "{written} bytes written"
     );
+}
+
+/// Issue 52: a run stopped by --max-output-mb wrote neither summary.json nor its final
+/// checkpoint (both were refused by the cap they report). Here a 1 MiB file written after two
+/// increments passes a 1 MiB cap, so the next frame of `sim.run()` stops the run.
+#[test]
+fn a_stop_on_the_output_cap_writes_its_summary_and_final_checkpoint() {
+    let src = format!(
+        "{SCENE}sim.settings(#{{ increments: 20 }});\nsim.step();\nsim.step();\n\
+         let s = \"x\"; for j in 0..20 {{ s += s; }}\nwrite_text(\"big.txt\", s);\nsim.run();\n"
+    );
+    let o = run("disk-stop", &src, &["--max-output-mb", "1"]);
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(o.stderr.contains("(raise it with --max-output-mb)"), "{}", o.stderr);
+    let out = o.dir.join("out");
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(summary["status"], "stopped");
+    let reason = summary["stop_reason"].as_str().unwrap();
+    assert!(reason.contains("--max-output-mb"), "{reason}");
+    // The two increments before the big file, and the one whose frame was refused.
+    let increments = summary["increments"].as_u64().unwrap();
+    assert!((2..=3).contains(&increments), "{increments} increments");
+    assert!(out.join("checkpoints/final.json").is_file(), "final checkpoint");
 }

@@ -238,11 +238,20 @@ fn script_size_and_depth_limits_stop_with_a_clear_message() {
     let err = run_inline("string", "let s = \"x\"; loop { s += s; }")
         .1
         .unwrap_err();
-    assert!(err.to_lowercase().contains("length of string"), "{err}");
+    // Issue 52: the messages name the bound (and the option where there is one), not
+    // only Rhai's "Length of string" / "Size of array".
+    assert!(
+        err.contains("a script string would be longer than 1 048 576 bytes"),
+        "{err}"
+    );
     let err = run_inline("array", "let a = [1]; loop { a += a; }")
         .1
         .unwrap_err();
-    assert!(err.to_lowercase().contains("size of array"), "{err}");
+    assert!(
+        err.contains("a script array would hold more than 65 536 entries")
+            && err.contains("--max-array-size"),
+        "{err}"
+    );
     let err = run_inline("depth", "fn f(n) { f(n + 1) }\nf(0);")
         .1
         .unwrap_err();

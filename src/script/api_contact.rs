@@ -12,7 +12,7 @@
 //! script builds), so an array of 11-entry maps stopped at about 6 000 candidate nodes
 //! ("Size of object map too large"). A [`ContactNode`] is a registered type with one getter
 //! per field: it reads like the map it replaces (`n.work`, `n.x[0]`) and counts as one
-//! array entry, so a query returns up to the array limit (4 194 304) of them, and the
+//! array entry, so a query returns up to the array limit (65 536 by default) of them, and the
 //! engine's limits stay as they are. `n.to_map()` gives the map when a script needs one
 //! (keys, `sim.summary`).
 

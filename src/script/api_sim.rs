@@ -340,6 +340,7 @@ impl SimState {
             let Some(model) = self.model.clone() else {
                 return runtime_error("the simulation has no model");
             };
+            refuse_free_body(&model)?;
             let mut sim = lift(Simulation::new(model))?;
             sim.set_interrupt(self.host.interrupt.clone());
             self.model = None;
@@ -732,6 +733,30 @@ fn load_checkpoint(
     let kept = ck.script.clone();
     ck.restore(sim)?;
     Ok((times, kept))
+}
+
+/// Refuses a model whose body is surely free to move as a rigid body: its supports
+/// (Dirichlet conditions) leave rigid-body modes free ([`rigid_modes`]) and nothing else
+/// can hold it, no tool (so no contact, no force-controlled tool) and no process step (whose
+/// supports are chosen later). Such a run used to "finish" with 0 Newton iterations and an
+/// energy error of 1. A body that only tools hold is left alone: contact may well hold it.
+///
+/// [`rigid_modes`]: crate::solver::model::rigid_modes
+fn refuse_free_body(model: &Model) -> ScriptResult<()> {
+    if !model.contacts.is_empty() || !model.steps.is_empty() || model.mesh.nodes.is_empty() {
+        return Ok(());
+    }
+    let free = crate::solver::model::rigid_modes::free_rigid_body_modes(model);
+    if free.is_empty() {
+        return Ok(());
+    }
+    runtime_error(format!(
+        "the body is free to move as a rigid body: its supports leave free {} and no tool can \
+         touch it\n  hold it: sim.fix(set, components) on enough nodes (e.g. sim.fix(\"z-\", \
+         \"xyz\")), prescribed displacements (sim.prescribe), or a tool in contact \
+         (sim.add_tool)",
+        free.join(", ")
+    ))
 }
 
 /// The error that ends a script on an interrupt: not catchable by the script's `try`.

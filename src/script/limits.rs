@@ -8,6 +8,15 @@
 //!   (`sim.run()`/`sim.step()` are timed apart and subtracted), checked with the memory.
 //! * **Increments** and **output size**: see [`Limits::max_increments`] and
 //!   [`crate::paths::set_output_limit`].
+//! * **Script arrays and maps**: entries one value may hold ([`Limits::max_array`],
+//!   [`Limits::max_map`]). Rhai checks the size of a container after every call that may
+//!   change it by counting all its entries (nested ones included), so building an array of
+//!   n entries one `push` at a time costs n²/2 visits: about 2.4 ns each on the test
+//!   machine, 5 s for 65 536 entries, hours for the 4 194 304 that were allowed before. The
+//!   bound is what keeps such a loop short; [`DEFAULT_MAX_ARRAY`] says why it is enough.
+//! * **A stop request** (SIGINT/SIGTERM, [`crate::interrupt::Interrupt`]) is polled with the
+//!   clock, so that a script busy in its own code (a loop, a script friction law) stops at
+//!   the first signal and the run records its stop as interrupted.
 
 use std::cell::Cell;
 use std::rc::Rc;
@@ -30,6 +39,19 @@ pub const BYTES_PER_NODE: u64 = 100_000;
 /// Resident memory of the process before any mesh.
 pub const BASE_BYTES: u64 = 20 << 20;
 
+/// Default bound on the entries of one script array (nested arrays and BLOB bytes counted;
+/// a record of `sim.history()` counts one). The largest arrays of the shipped scripts are
+/// histories of a few thousand increments and node lists of the 7 803-node 50 x 50 x 2 cup;
+/// 65 536 holds ten times either, and a script that builds one entry at a time reaches it in
+/// about 5 s (see the module docs) rather than running to the script time limit.
+pub const DEFAULT_MAX_ARRAY: usize = 1 << 16;
+/// Default bound on the entries of the maps in one value (nested maps counted): the same
+/// bound as arrays, for the same quadratic cost of Rhai's size check.
+pub const DEFAULT_MAX_MAP: usize = 1 << 16;
+/// Bound on the length of one script string, in bytes (1 MiB: a script's messages and
+/// file names; tables are read from files, not built as strings).
+pub const MAX_STRING: usize = 1 << 20;
+
 /// The bounds of one run.
 #[derive(Clone, Debug)]
 pub struct Limits {
@@ -42,6 +64,10 @@ pub struct Limits {
     pub max_increments: usize,
     /// Bytes the run may write into its output folder.
     pub max_output: u64,
+    /// Entries one script array may hold ([`DEFAULT_MAX_ARRAY`]).
+    pub max_array: usize,
+    /// Entries the maps of one script value may hold ([`DEFAULT_MAX_MAP`]).
+    pub max_map: usize,
 }
 
 impl Default for Limits {
@@ -51,6 +77,8 @@ impl Default for Limits {
             max_script_time: Duration::from_secs(600),
             max_increments: 100_000,
             max_output: 20 << 30,
+            max_array: DEFAULT_MAX_ARRAY,
+            max_map: DEFAULT_MAX_MAP,
         }
     }
 }
@@ -131,10 +159,19 @@ impl ScriptClock {
 }
 
 /// The progress callback of the engine: `Some(message)` stops the script (Rhai reports it as
-/// a termination carrying the message).
-pub fn progress_check(limits: &Limits, clock: &Rc<ScriptClock>, ops: u64) -> Option<String> {
+/// a termination carrying the message). A raised stop request stops it first ("interrupted:
+/// SIGTERM received"): the host then records the stop as interrupted.
+pub fn progress_check(
+    limits: &Limits,
+    clock: &Rc<ScriptClock>,
+    interrupt: &crate::interrupt::Interrupt,
+    ops: u64,
+) -> Option<String> {
     if ops % CHECK_EVERY != 0 {
         return None;
+    }
+    if interrupt.is_raised() {
+        return Some(format!("interrupted: {}", interrupt.reason()));
     }
     let t = clock.script_time();
     if t > limits.max_script_time {
@@ -152,6 +189,44 @@ pub fn progress_check(limits: &Limits, clock: &Rc<ScriptClock>, ops: u64) -> Opt
             mib(limits.max_memory)
         )),
         _ => None,
+    }
+}
+
+/// The message of a Rhai "too large" stop (`what`: Rhai's "Size of array/BLOB", "Size of
+/// object map", "Length of string"), naming the bound and how to raise it.
+pub fn data_too_large(what: &str, limits: &Limits) -> String {
+    let count = |n: usize| {
+        let digits = n.to_string();
+        let mut out = String::new();
+        for (i, c) in digits.chars().enumerate() {
+            if i > 0 && (digits.len() - i) % 3 == 0 {
+                out.push(' ');
+            }
+            out.push(c);
+        }
+        out
+    };
+    if what.contains("array") {
+        format!(
+            "a script array would hold more than {} entries (nested arrays counted), the bound \
+             on what a script builds (raise it with --max-array-size; each entry added one at \
+             a time costs a count of the whole array, so a larger bound is slower to reach)",
+            count(limits.max_array)
+        )
+    } else if what.contains("map") {
+        format!(
+            "script maps would hold more than {} entries in one value (nested maps counted), \
+             the bound on what a script builds (raise it with --max-map-size)",
+            count(limits.max_map)
+        )
+    } else if what.contains("string") {
+        format!(
+            "a script string would be longer than {} bytes, the bound on what a script builds \
+             (a fixed bound: write long text with the output functions, read tables from files)",
+            count(MAX_STRING)
+        )
+    } else {
+        format!("{what} too large")
     }
 }
 

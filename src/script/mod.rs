@@ -149,9 +149,9 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     engine.set_max_operations(host.max_operations);
     engine.set_max_call_levels(64);
     engine.set_max_expr_depths(128, 64);
-    engine.set_max_string_size(1 << 20);
-    engine.set_max_array_size(1 << 22);
-    engine.set_max_map_size(1 << 16);
+    engine.set_max_string_size(limits::MAX_STRING);
+    engine.set_max_array_size(host.limits.max_array);
+    engine.set_max_map_size(host.limits.max_map);
     let policy = Rc::new(read_policy(host, script_dir).unwrap_or_else(|_| ReadPolicy::nothing()));
     engine.set_module_resolver(stdlib::resolver(policy.clone()));
     if !host.script_print {
@@ -160,7 +160,10 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     let mut host = host.clone();
     host.clock = Rc::default();
     let (limits, clock) = (host.limits.clone(), host.clock.clone());
-    engine.on_progress(move |ops| limits::progress_check(&limits, &clock, ops).map(Dynamic::from));
+    let interrupt = host.interrupt.clone();
+    engine.on_progress(move |ops| {
+        limits::progress_check(&limits, &clock, &interrupt, ops).map(Dynamic::from)
+    });
     let host = Rc::new(host);
     api_scene::register(&mut engine, host.clone());
     api_cad::register(&mut engine, policy.clone());
@@ -244,10 +247,11 @@ pub fn explain_late_sets(host: &HostOptions, message: String) -> String {
 }
 
 /// Formats a Rhai error as "file:line:column: message". An error inside a function of
-/// another source (a std-lib module) is reported where this file called it.
-pub fn describe_error(file: &str, err: &EvalAltResult) -> String {
+/// another source (a std-lib module) is reported where this file called it; a size bound
+/// is named with its value and option (`limits`).
+pub fn describe_error(file: &str, err: &EvalAltResult, limits: &limits::Limits) -> String {
     let pos = innermost_position(file, err);
-    let msg = message(err);
+    let msg = message(err, limits);
     match (pos.line(), pos.position()) {
         (Some(l), Some(c)) => format!("{file}:{l}:{c}: {msg}"),
         (Some(l), None) => format!("{file}:{l}: {msg}"),
@@ -256,12 +260,15 @@ pub fn describe_error(file: &str, err: &EvalAltResult) -> String {
 }
 
 /// The message of an error, with a limit's own text for a script the progress check stopped.
-fn message(err: &EvalAltResult) -> String {
+fn message(err: &EvalAltResult, limits: &limits::Limits) -> String {
     match err {
         EvalAltResult::ErrorTerminated(why, _) => format!("stopped: {why}"),
+        EvalAltResult::ErrorDataTooLarge(what, _) => limits::data_too_large(what, limits),
         EvalAltResult::ErrorInFunctionCall(_, _, inner, _) => {
-            if let EvalAltResult::ErrorTerminated(..) = &**inner {
-                message(inner)
+            if let EvalAltResult::ErrorTerminated(..) | EvalAltResult::ErrorDataTooLarge(..) =
+                &**inner
+            {
+                message(inner, limits)
             } else {
                 err.to_string()
             }
@@ -355,7 +362,7 @@ pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions
     let outcome = engine
         .run_ast_with_scope(&mut scope, &ast)
         .map_err(|e| {
-            let text = describe_error(&path.display().to_string(), &e);
+            let text = describe_error(&path.display().to_string(), &e, &host.limits);
             Error::Script(explain_late_sets(host, text))
         })
         .and_then(|()| host.simulations.close());

@@ -7,7 +7,7 @@
 //! `sim.history()`, with 19 entries an increment and two of each tool, at about 3 100
 //! increments of a one-tool run. A
 //! [`Record`] is a registered type; the size check does not look inside it, so an array of
-//! records is bounded only by the array limit (4 194 304 entries). It reads like the map
+//! records is bounded only by the array limit (65 536 entries by default, `--max-array-size`). It reads like the map
 //! it carries: `r.time` and `r["time"]` (an indexer, which Rhai also uses for property
 //! access), `"time" in r`, `r.keys()`; printed as the map; `r.to_map()` gives the map where
 //! a script needs one (`sim.summary`, changing it).

@@ -54,7 +54,7 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
             ),
             Err(e) => println!(
                 "error while loading: {}",
-                describe_error(&path.display().to_string(), &e)
+                describe_error(&path.display().to_string(), &e, &host.limits)
             ),
         }
     }
@@ -206,7 +206,7 @@ pub fn outcome_line(
         }
         Err(e) => format!(
             "error: {}",
-            super::explain_late_sets(host, describe_error("<repl>", e))
+            super::explain_late_sets(host, describe_error("<repl>", e, &host.limits))
         ),
     }
 }

@@ -10,7 +10,10 @@
 //! the loaded shape and springback measures of release steps (`simulation::springback`),
 //! and the increment reports so far. The model itself (mesh, materials, tools, schedules, settings) is not
 //! stored: the script builds it again, and [`Checkpoint::restore`] checks that it matches
-//! (sizes, tool names and candidates, tool positions at the checkpoint's time).
+//! (sizes, tool names and candidates, tool positions at the checkpoint's time, and FNV-1a
+//! fingerprints of the mesh, the tools' surfaces, the material and each tool's friction law,
+//! taken from their descriptions: a restart with another material or law is refused, naming
+//! the field; checkpoints written before a fingerprint existed skip that comparison).
 //!
 //! Numbers are written by serde_json in shortest round-trip form and read back with its
 //! `float_roundtrip` parser, so every f64 is restored bit for bit and a restarted run
@@ -129,6 +132,13 @@ pub struct Fingerprint {
     /// FNV-1a hash of each tool's surface description, as 16 hex digits.
     #[serde(default)]
     pub tool_hashes: Vec<String>,
+    /// FNV-1a hash of the material's description (its law and every parameter), so that a
+    /// restart with another material is refused (a script function's body is not in it).
+    #[serde(default)]
+    pub material_hash: String,
+    /// FNV-1a hash of each tool's friction law description (law and parameters).
+    #[serde(default)]
+    pub friction_hashes: Vec<String>,
 }
 
 /// 64-bit FNV-1a, written as 16 hex digits (JSON numbers would lose the high bits).
@@ -171,6 +181,13 @@ impl Fingerprint {
                 .contacts
                 .iter()
                 .map(|c| fnv1a(c.tool.surface.describe().into_bytes()))
+                .collect(),
+            material_hash: fnv1a(sim.model.material.describe().into_bytes()),
+            friction_hashes: sim
+                .model
+                .contacts
+                .iter()
+                .map(|c| fnv1a(c.tool.friction.describe().into_bytes()))
                 .collect(),
         }
     }
@@ -250,6 +267,12 @@ impl Checkpoint {
         if self.model.tool_hashes.is_empty() {
             here.tool_hashes.clear();
         }
+        if self.model.material_hash.is_empty() {
+            here.material_hash.clear();
+        }
+        if self.model.friction_hashes.is_empty() {
+            here.friction_hashes.clear();
+        }
         if here != self.model {
             let what = if here.nodes != self.model.nodes || here.elements != self.model.elements {
                 format!(
@@ -283,6 +306,21 @@ impl Checkpoint {
                 format!(
                     "model.tool_hashes[{c}]: the surface of tool '{}' differs from the checkpoint's",
                     here.tools.get(c).map_or("", |t| t.0.as_str())
+                )
+            } else if here.material_hash != self.model.material_hash {
+                format!(
+                    "model.material_hash: the material differs from the checkpoint's (the script's: {})",
+                    sim.model.material.describe()
+                )
+            } else if here.friction_hashes != self.model.friction_hashes {
+                let c = (here.friction_hashes.iter())
+                    .zip(&self.model.friction_hashes)
+                    .position(|(a, b)| a != b)
+                    .unwrap_or(0);
+                format!(
+                    "model.friction_hashes[{c}]: the friction law of tool '{}' differs from the checkpoint's (the script's: {})",
+                    here.tools.get(c).map_or("", |t| t.0.as_str()),
+                    sim.model.contacts.get(c).map_or(String::new(), |t| t.tool.friction.describe())
                 )
             } else {
                 "contact candidates or unknowns differ (enforcement, node sets)".to_string()
@@ -484,8 +522,9 @@ fn check_per_cell(
 
 impl Checkpoint {
     /// Checks every value of the state against what a converged state can hold: finite
-    /// numbers, displacements within 1000 times the mesh's size, multipliers and stresses
-    /// finite, mu, frictional work, slip, equivalent plastic strain >= 0, det F > 0, a
+    /// numbers, displacements within 1000 times the mesh's size, multipliers (contact
+    /// forces) within 1000 times the largest elastic stiffness times the size squared,
+    /// stresses finite, mu, frictional work, slip, equivalent plastic strain >= 0, det F > 0, a
     /// positive next increment. The error names the field (`state.contact[0][12].mu`) and
     /// its value. A checkpoint is JSON that a person can edit: this keeps an edited or
     /// damaged file from starting a run from a state no increment could have produced.
@@ -521,6 +560,26 @@ impl Checkpoint {
         );
         let size = (hi - lo).norm().max(f64::MIN_POSITIVE);
         let bound = 1e3 * size;
+        // A multiplier is a nodal contact force: a stress times an area. Displacements are
+        // bounded by 1000 sizes (so strains by about 1000), stresses then by 1000 times the
+        // largest elastic stiffness, areas by size^2: a force past that bound is not one a
+        // converged state of this model holds (1e300 in an edited file, say).
+        let stiffness = sim.model.material.elastic_tangent().abs().max();
+        let force_bound = (1e3 * stiffness * size * size).max(f64::MIN_POSITIVE);
+        let force = |field: &dyn Fn() -> String, v: f64| {
+            if v.abs() <= force_bound {
+                Ok(())
+            } else {
+                refuse(
+                    field(),
+                    v,
+                    &format!(
+                        "must be finite and within +-{force_bound:e} (1000 times the largest \
+                         elastic stiffness times the mesh's size squared)"
+                    ),
+                )
+            }
+        };
         non_negative(&|| "state.time".into(), s.time)?;
         let n_u = 3 * mesh.nodes.len();
         for (i, &v) in s.x.iter().enumerate() {
@@ -539,7 +598,7 @@ impl Checkpoint {
                     );
                 }
             } else {
-                finite(&|| format!("state.x[{i}] (a multiplier)"), v)?;
+                force(&|| format!("state.x[{i}] (a multiplier)"), v)?;
             }
         }
         for (p, point) in s.points.iter().enumerate() {
@@ -573,8 +632,10 @@ impl Checkpoint {
         for (c, nodes) in s.contact.iter().enumerate() {
             for (k, n) in nodes.iter().enumerate() {
                 let field = |name: &str| format!("state.contact[{c}][{k}].{name}");
+                for (i, &x) in n.lambda.iter().enumerate() {
+                    force(&|| format!("{}[{i}]", field("lambda")), x)?;
+                }
                 for (name, v) in [
-                    ("lambda", n.lambda),
                     ("x_ref_local", n.x_ref_local),
                     ("normal", n.normal),
                     ("slip_increment", n.slip_increment),

@@ -175,6 +175,9 @@ pub struct Simulation {
     /// Whether the run has explained a step limit exceeded at the minimum step (in full
     /// once per run; later increments get one short line each).
     pub(super) limit_explained: bool,
+    /// Increments in a row held at the floor dt_min (`step_control`, "Crawl floor"); not
+    /// kept in checkpoints: a restart counts afresh.
+    pub(super) at_floor: usize,
     /// The tools' schedules as the model gave them, before steps ended early changed
     /// them (module `step_end`).
     pub(super) base_schedules: Vec<crate::tool::Schedule>,
@@ -327,6 +330,7 @@ impl Simulation {
             cycling_explained: false,
             discarded_steps: 0,
             limit_explained: false,
+            at_floor: 0,
             base_schedules: model
                 .contacts
                 .iter()

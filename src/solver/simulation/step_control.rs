@@ -25,6 +25,17 @@
 //!
 //! "fixed" stepping keeps `end_time / increments` with halving cutbacks on failure; it is
 //! the default, so the verification tests keep their exact increment sequences.
+//!
+//! **Crawl floor.** An increment is *held at the floor* when it was taken at `dt_min` and
+//! the control wanted a smaller one: a limit exceeded even at `dt_min` (`R < 1`), or a cutback
+//! down to it. Each such increment advances the run by `dt_min` only (10^-6 of the run at the
+//! default), so a run held there for [`CRAWL_INCREMENTS`] increments in a row stops with the
+//! reason (the setting `dt_min`, the number of increments at it, the time reached): going on
+//! would cost up to `(end_time - t) / dt_min` more increments (hours for a block dragged off
+//! a tool's edge) for a process followed no better than the limits it keeps exceeding. The
+//! stop keeps everything computed, as other stops do (summary.json, final checkpoint). A
+//! run that leaves the floor resets the count; steps at `dt_min` chosen on purpose
+//! (`dt_max = dt_min`) with no limit exceeded are not held there and never counted.
 
 use crate::material::PointState;
 use crate::solver::model::Model;
@@ -111,6 +122,24 @@ impl IncrementMeasures {
         }
         best
     }
+}
+
+/// Increments in a row held at the floor `dt_min` after which a run stops (module doc): at
+/// most 100 dt_min of progress bought with as many full Newton solves. A run passing a hard
+/// spot (a contact switch, a tool's edge) leaves the floor within a few increments (the
+/// step doubles after an easy one), far fewer than this.
+pub const CRAWL_INCREMENTS: usize = 100;
+
+/// The reason of a crawl stop: the setting, the increments at it, the time reached.
+pub fn crawl_message(dt_min: f64, increments: usize, time: f64, end_time: f64) -> String {
+    format!(
+        "the run crawls at the minimum step: {increments} increments in a row at dt_min = {dt_min:e} \
+         (setting dt_min) reached t = {time:.6e} of end_time = {end_time}, and the rest would take up \
+         to {} more; stopped (the rule: {CRAWL_INCREMENTS} increments in a row held at dt_min by an \
+         exceeded limit or a cutback). Look at the last state (checkpoints/final.json, the column \
+         step_limit of history.csv) for what holds the step back; raise dt_min to go on in coarser steps",
+        ((end_time - time) / dt_min).ceil().max(0.0)
+    )
 }
 
 /// The warning of an increment whose step limit even the minimum step exceeds: which limit

@@ -342,6 +342,23 @@ impl Simulation {
                     };
                     report.next_dt = next;
                     self.history.push(report.clone());
+                    let held = dt_used <= dt_min * (1.0 + 1e-9)
+                        && (ratio < 1.0 || cutbacks.count() > 0);
+                    self.at_floor = if held { self.at_floor + 1 } else { 0 };
+                    if self.at_floor >= crate::solver::simulation::step_control::CRAWL_INCREMENTS
+                        && !self.is_finished()
+                    {
+                        // Committed and in history: the stop keeps this increment.
+                        return Err(Error::no_convergence(
+                            crate::error::Failure::Stalled,
+                            crate::solver::simulation::step_control::crawl_message(
+                                dt_min,
+                                self.at_floor,
+                                self.time,
+                                end,
+                            ),
+                        ));
+                    }
                     return Ok(report);
                 }
                 Err(err @ Error::Interrupted(_)) => return Err(err),
