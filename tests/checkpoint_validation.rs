@@ -189,7 +189,10 @@ fn a_checkpoint_of_another_material_or_friction_law_is_refused() {
     let mut stiffer = model();
     stiffer.material = common::elastic(2000.0, 0.3);
     let err = restore_into(stiffer).unwrap_err();
-    assert!(err.contains("model.material_hash") && err.contains("2000"), "{err}");
+    assert!(
+        err.contains("model.material_hash") && err.contains("2000"),
+        "{err}"
+    );
     let mut rougher = model();
     rougher.contacts[0].tool.friction = tribo::contact::FrictionLaw::coulomb(0.3).unwrap();
     let err = restore_into(rougher).unwrap_err();

@@ -197,9 +197,15 @@ fn a_body_free_to_move_is_refused_naming_its_free_directions() {
     );
     for direction in ["x", "y", "z"] {
         assert!(err.contains(&format!("translation {direction}")), "{err}");
-        assert!(err.contains(&format!("rotation about {direction}")), "{err}");
+        assert!(
+            err.contains(&format!("rotation about {direction}")),
+            "{err}"
+        );
     }
-    assert!(err.contains("sim.fix") && err.contains("sim.add_tool"), "{err}");
+    assert!(
+        err.contains("sim.fix") && err.contains("sim.add_tool"),
+        "{err}"
+    );
     // Held in z on its bottom face: free in x, y and about z only, and so named.
     let (code, err) = run(
         "partial",
@@ -238,11 +244,13 @@ fn a_run_crawling_at_the_minimum_step_stops_with_the_reason() {
                sim.run();\n";
     // Before the rule the run went on to the --max-increments cap (set low here so that the
     // old behaviour fails in seconds rather than crawling 10^6 increments).
-    let (code, err, dir) = common::run_script_in("hostile", "crawl", src, &["--max-increments", "2000"]);
+    let (code, err, dir) =
+        common::run_script_in("hostile", "crawl", src, &["--max-increments", "2000"]);
     assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains("the run crawls at the minimum step: 100 increments in a row at dt_min = 1e-6")
-            && err.contains("(setting dt_min)")
+        err.contains(
+            "the run crawls at the minimum step: 100 increments in a row at dt_min = 1e-6"
+        ) && err.contains("(setting dt_min)")
             && err.contains("reached t = "),
         "{err}"
     );
@@ -251,11 +259,17 @@ fn a_run_crawling_at_the_minimum_step_stops_with_the_reason() {
     let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(summary["status"], "stopped");
     assert!(
-        summary["stop_reason"].as_str().unwrap().contains("crawls at the minimum step"),
+        summary["stop_reason"]
+            .as_str()
+            .unwrap()
+            .contains("crawls at the minimum step"),
         "{}",
         summary["stop_reason"]
     );
     let increments = summary["increments"].as_u64().unwrap();
     assert!((100..2000).contains(&increments), "{increments} increments");
-    assert!(out.join("checkpoints/final.json").is_file(), "final checkpoint");
+    assert!(
+        out.join("checkpoints/final.json").is_file(),
+        "final checkpoint"
+    );
 }

@@ -212,7 +212,13 @@ fn start_busy_script(tag: &str, cells: usize) -> (Child, PathBuf, PathBuf) {
         .arg(&out)
         // The memory bound raised past the estimate of 100 KB per node of a simulated mesh:
         // these meshes are built and dropped, never simulated (about 100 bytes a node).
-        .args(["--quiet", "--max-script-seconds", "600", "--max-memory-mb", "1000000"])
+        .args([
+            "--quiet",
+            "--max-script-seconds",
+            "600",
+            "--max-memory-mb",
+            "1000000",
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -250,7 +256,10 @@ fn assert_busy_script_interrupted(mut child: Child, out: &Path, dir: &Path) {
     let stopped = summary(out);
     assert_eq!(stopped["status"], "interrupted");
     assert_eq!(stopped["increments"], 2);
-    assert!(out.join("checkpoints/final.json").is_file(), "final checkpoint");
+    assert!(
+        out.join("checkpoints/final.json").is_file(),
+        "final checkpoint"
+    );
     assert!(!out.join(".tribo.lock").exists(), "the lock is released");
     let _ = std::fs::remove_dir_all(dir);
 }

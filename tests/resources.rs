@@ -324,7 +324,11 @@ fn a_stop_on_the_output_cap_writes_its_summary_and_final_checkpoint() {
     );
     let o = run("disk-stop", &src, &["--max-output-mb", "1"]);
     assert_eq!(o.code, 1, "{}", o.stderr);
-    assert!(o.stderr.contains("(raise it with --max-output-mb)"), "{}", o.stderr);
+    assert!(
+        o.stderr.contains("(raise it with --max-output-mb)"),
+        "{}",
+        o.stderr
+    );
     let out = o.dir.join("out");
     let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
     let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -334,5 +338,8 @@ fn a_stop_on_the_output_cap_writes_its_summary_and_final_checkpoint() {
     // The two increments before the big file, and the one whose frame was refused.
     let increments = summary["increments"].as_u64().unwrap();
     assert!((2..=3).contains(&increments), "{increments} increments");
-    assert!(out.join("checkpoints/final.json").is_file(), "final checkpoint");
+    assert!(
+        out.join("checkpoints/final.json").is_file(),
+        "final checkpoint"
+    );
 }
