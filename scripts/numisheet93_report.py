@@ -112,7 +112,7 @@ def results_table(runs, measured):
     return "\n".join(lines)
 
 
-def difference_table(runs, measured):
+def difference_table(runs, measured, finest):
     lines = ["| material | model | DX 15 | DY 15 | DD 15 | DX 40 | DY 40 | DD 40 |",
              "|---|---|---|---|---|---|---|---|"]
     for key, label in MATERIALS:
@@ -128,6 +128,18 @@ def difference_table(runs, measured):
             if all(c == "–" for c in row):
                 continue
             lines.append(f"| {label} | {mesh} | " + " | ".join(row) + " |")
+        seq = finest.get(label)
+        if seq is None:
+            continue
+        row = []
+        for q, mm in QUANTITIES:
+            mean, _ = measured_value(measured, label, q, mm)
+            e = seq["result"][f"{q.upper()} {mm}"]
+            row.append("–" if mean is None else
+                       f"{100.0 * (e['value'] - mean) / mean:+.1f} % ± {100.0 * e['uncertainty'] / mean:.1f} %")
+        if any(c != "–" for c in row):
+            meshes = "-".join(MODEL[m].split()[1] for _, m, _ in reversed(seq["members"]))
+            lines.append(f"| {label} | **extrapolated** ({meshes}), with its GCI band | " + " | ".join(row) + " |")
     return "\n".join(lines)
 
 
@@ -452,7 +464,7 @@ def main():
             for (label, c), seq in all_seqs.items()}, f, indent=1)
     text = (text.replace("{{COMMIT}}", git_commit())
             .replace("{{RESULTS}}", results_table(runs, measured))
-            .replace("{{DIFFERENCES}}", difference_table(runs, measured))
+            .replace("{{DIFFERENCES}}", difference_table(runs, measured, finest))
             .replace("{{PAIR}}", pair_table(runs) or "(one of the pair's runs did not finish this session)")
             .replace("{{SENS_ALUMINIUM}}", sens["aluminium"])
             .replace("{{SENS_STEEL}}", sens["steel"])

@@ -31,12 +31,6 @@ use crate::{Error, Result};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// A direction cosine below which the tool normal counts as lying across a coordinate
-/// axis (`multiplier_unit_rows`): setting that multiplier component to zero then moves
-/// the normal force by at most this fraction of it, far below the contact tolerance; in
-/// plane strain and on symmetry planes it is exactly 0.
-const ACROSS_NORMAL: f64 = 1e-9;
-
 /// Threads for the elements and the factorization of the setting `threads` (0: every core).
 pub(super) fn worker_threads(setting: usize) -> usize {
     match setting {
@@ -560,36 +554,16 @@ impl IncrementContext<'_> {
             .unwrap_or_else(|e| e.into_inner())
     }
 
-    /// The multiplier components `k` of a pair whose equation becomes `lambda_k = 0`, all
-    /// with a prescribed displacement component `k` of the candidate `node` (its
-    /// equilibrium row `k` is a Dirichlet row, so `lambda_k` reaches the system through
-    /// the pair's own rows only):
-    ///
-    /// - a sticking node, every such `k` (see `contact_pairs`);
-    /// - a slipping node, each such `k` across the tool normal (`|n_k| <= ACROSS_NORMAL`,
-    ///   as in plane strain and on a symmetry plane). There the operator's row reads
-    ///   `lambda_k = F_equi_k = -mu sigma_n t_k`, zero when the node does not slip along
-    ///   `k` (a prescribed component held still), so `lambda_k = 0` is its solution;
-    ///   otherwise the support takes the friction force along `k`, as for a sticking node.
-    ///   The operator's row is singular on the Coulomb cone:
-    ///   `dF_suppl_k / dlambda_k = -(1 + mu sigma_n / |sigma_t|) / r` vanishes at
-    ///   `|sigma_t| = mu |sigma_n|` (a node that slipped in the last increment and has not
-    ///   moved yet, as at the first iterate of a release), and the column has no other
-    ///   entry outside the Dirichlet row (issue 47). The choice depends on the status and
-    ///   the normal only, never on `lambda_k` itself, so the residual stays one function
-    ///   of the unknowns (its finite differences match the Jacobian).
+    /// The multiplier components `k` of a pair whose equation becomes `lambda_k = 0`: a
+    /// sticking candidate `node` with a prescribed displacement component `k` (see
+    /// `evaluate_with`).
     fn multiplier_unit_rows<'b>(
         &'b self,
         result: &NodalContact,
         node: usize,
     ) -> impl Iterator<Item = usize> + 'b {
-        use crate::contact::ContactStatus;
-        let across = match (result.status, result.sigma_model.as_ref()) {
-            (ContactStatus::Slip, Some(m)) => [0, 1, 2].map(|k| m.normal[k].abs() <= ACROSS_NORMAL),
-            _ => [false; 3],
-        };
-        let stick = result.status == ContactStatus::Stick;
-        (0..3).filter(move |&k| (stick || across[k]) && self.is_fixed[3 * node + k])
+        let stick = result.status == crate::contact::ContactStatus::Stick;
+        (0..3).filter(move |&k| stick && self.is_fixed[3 * node + k])
     }
 
     /// Adds one contact pair's blocks (operator output `result` of a candidate of
@@ -818,9 +792,7 @@ impl IncrementContext<'_> {
                     // tangential force along k and the support reaction are one and the same
                     // unknown (the Jacobian is singular), so the support carries it:
                     // lambda_k = 0. This is exact on symmetry planes and in plane strain,
-                    // where the tool normal lies in the constrained plane. A slipping node's
-                    // component across its normal likewise (its row is singular on the
-                    // Coulomb cone: `multiplier_unit_rows`).
+                    // where the tool normal lies in the constrained plane.
                     for k in self.multiplier_unit_rows(&result, node) {
                         unit_rows.push((l + k, lambda[k]));
                     }
