@@ -458,28 +458,21 @@ fn main() -> ExitCode {
     }
 }
 
-/// `tribo extrapolate FILE`: the input read (at most 16 MB, a regular file or standard
-/// input), the extrapolations printed as JSON.
+/// `tribo extrapolate FILE`: the input read (a regular file by the command line's read
+/// policy, `paths::read_named_text`, or standard input; at most 16 MiB), the extrapolations
+/// printed as JSON.
 fn extrapolate(file: &std::path::Path) -> tribo::Result<()> {
     use std::io::Read;
+    let limit: u64 = 16 << 20;
     let (text, source) = if file == std::path::Path::new("-") {
         let mut text = String::new();
         std::io::stdin()
-            .take(16 << 20)
+            .take(limit)
             .read_to_string(&mut text)
             .map_err(|e| tribo::Error::Input(format!("standard input: {e}")))?;
         (text, "standard input".to_string())
     } else {
-        let meta = std::fs::metadata(file)
-            .map_err(|e| tribo::Error::Input(format!("{}: {e}", file.display())))?;
-        if !meta.is_file() || meta.len() > 16 << 20 {
-            return Err(tribo::Error::Input(format!(
-                "{}: not a regular file of at most 16 MB",
-                file.display()
-            )));
-        }
-        let text = std::fs::read_to_string(file)
-            .map_err(|e| tribo::Error::Input(format!("{}: {e}", file.display())))?;
+        let text = tribo::paths::read_named_text(file, limit, "extrapolation input")?;
         (text, file.display().to_string())
     };
     let out = tribo::study::extrapolate::run(&text, &source)?;
