@@ -505,6 +505,16 @@ fn cup_stroke_tool_side_work_equals_the_dissipation_on_every_tool() {
         tools += work;
     }
     assert!(sheet > 0.0 && (tools - sheet).abs() <= 1e-8 * sheet);
+    // The run's own clock accounts for the fields (issue 53's cost, BENCHMARKS.md [w]):
+    // their accumulation and the tool frames that carry them are timed phases.
+    let phases = &summary["phase_times_s"];
+    for phase in ["tool_fields", "tool_frames", "frames"] {
+        let seconds = phases[phase].as_f64().unwrap();
+        assert!(
+            seconds > 0.0 && seconds < summary["wall_time_s"].as_f64().unwrap(),
+            "{phase}: {seconds}"
+        );
+    }
     // The die (drawn over its entry radius) wears; its wear lies on the die's surface.
     let die = &summary["tools"]["die"]["tool_fields"];
     assert!(die["max_wear_depth"].as_f64().unwrap() > 0.0);

@@ -115,6 +115,10 @@ pub struct RunOutput {
     /// Per tool with tool-side fields, its field grid's nodes sampled once for all its
     /// frames (`tool_fields::GridSamples`: the surface does not change during a run).
     field_samples: Vec<Option<super::tool_fields::GridSamples>>,
+    /// Seconds spent writing frames: the blank's, and the tools' (summary.json's
+    /// `phase_times_s.frames` and `.tool_frames`), so that a run says what its output cost.
+    frame_seconds: f64,
+    tool_frame_seconds: f64,
 }
 
 impl RunOutput {
@@ -201,6 +205,8 @@ impl RunOutput {
             extra: serde_json::Map::new(),
             frame_times: Vec::new(),
             field_samples: Vec::new(),
+            frame_seconds: 0.0,
+            tool_frame_seconds: 0.0,
         })
     }
 
@@ -350,10 +356,13 @@ impl RunOutput {
     pub fn write_frame(&mut self, sim: &Simulation) -> Result<()> {
         let index = self.frame_times.len();
         let files = self.frame_files(sim, index);
+        let started = std::time::Instant::now();
         write_vtu(
             &self.folder.resolve_for_write(&files[0].1)?,
             &blank_frame::frame_against(sim, self.frames.points, None, &self.frames.formability),
         )?;
+        let tools_started = std::time::Instant::now();
+        self.frame_seconds += (tools_started - started).as_secs_f64();
         let mut tool_files = files[1..].iter();
         let region = tool_frame::DisplayRegion::around(&sim.model.mesh.nodes);
         for (c, contact) in sim.model.contacts.iter().enumerate() {
@@ -373,6 +382,7 @@ impl RunOutput {
                 write_vtu(&self.folder.resolve_for_write(file)?, &tool)?;
             }
         }
+        self.tool_frame_seconds += tools_started.elapsed().as_secs_f64();
         let parts: Vec<(&str, &Path)> = (files.iter())
             .map(|(n, f)| (n.as_str(), Path::new(f.as_str())))
             .collect();
@@ -552,6 +562,9 @@ impl RunOutput {
                 "elements": sim.phase_times.elements,
                 "contact": sim.phase_times.contact,
                 "factorization_and_solve": sim.phase_times.factorization_and_solve,
+                "tool_fields": sim.phase_times.tool_fields,
+                "frames": self.frame_seconds,
+                "tool_frames": self.tool_frame_seconds,
             },
             "evaluations": {
                 "full": sim.phase_times.full_evaluations,

@@ -239,6 +239,10 @@ pub struct PhaseTimes {
     pub elements: f64,
     pub contact: f64,
     pub factorization_and_solve: f64,
+    /// Accumulating the tool-side fields of committed increments (`ToolFields::accumulate`,
+    /// issue 53): timed inside the run so that its share of the run's time is measured
+    /// without a second run, whatever the host's speed does meanwhile.
+    pub tool_fields: f64,
     /// Evaluations with element tangents and assembly ([`IncrementContext::evaluate`]).
     pub full_evaluations: usize,
     /// Residual-only evaluations ([`IncrementContext::evaluate_residual`]).
@@ -261,6 +265,7 @@ impl PhaseTimes {
         self.elements += other.elements;
         self.contact += other.contact;
         self.factorization_and_solve += other.factorization_and_solve;
+        self.tool_fields += other.tool_fields;
         self.full_evaluations += other.full_evaluations;
         self.residual_evaluations += other.residual_evaluations;
         self.jacobian_completions += other.jacobian_completions;
@@ -273,6 +278,7 @@ impl PhaseTimes {
         self.elements += other.elements;
         self.contact += other.contact;
         self.factorization_and_solve += other.factorization_and_solve;
+        self.tool_fields += other.tool_fields;
     }
 
     /// The counts alone (no times), as a checkpoint keeps them.

@@ -721,6 +721,7 @@ impl Simulation {
             }
             tool_forces.push([total.x, total.y, total.z]);
             if let Some(fields) = self.tool_fields[c].as_mut() {
+                let started = std::time::Instant::now();
                 let position = |n: usize| {
                     self.model.mesh.nodes[n] + Vec3::new(x[3 * n], x[3 * n + 1], x[3 * n + 2])
                 };
@@ -732,6 +733,7 @@ impl Simulation {
                     &loads,
                     t_new - self.time,
                 );
+                self.phase_times.tool_fields += started.elapsed().as_secs_f64();
             }
         }
         let energy = self.account_energy(t_new, &x, &eval, &tool_forces, &dissipated, &normal_work);
