@@ -29,6 +29,11 @@ FACTORS = [
     ("holder_minus", "blankholder force - 10 % (17.64 kN)"),
     ("holder_plus", "blankholder force + 10 % (21.56 kN)"),
     ("von_mises", "von Mises instead of Hill48"),
+    ("die_radius_minus", "die entry radius 7.5 mm (8 - 0.5: our tolerance)"),
+    ("die_radius_plus", "die entry radius 8.5 mm (8 + 0.5)"),
+    ("punch_radius_minus", "punch nose radius 7.5 mm (8 - 0.5)"),
+    ("punch_radius_plus", "punch nose radius 8.5 mm (8 + 0.5)"),
+    ("layers2", "two solid-shell layers instead of one"),
 ]
 
 

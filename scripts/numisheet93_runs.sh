@@ -6,7 +6,7 @@
 # skipped, so the script can be re-entered, and run twice at once on the same OUT to use both
 # cores. Runs niced (the machine is shared): NICE=0 gives a runner its core back.
 #
-#   scripts/numisheet93_runs.sh [OUT] [GROUP...]      GROUP: base25 pair25 sens25 base35 base50 base71 base100 fbar25
+#   scripts/numisheet93_runs.sh [OUT] [GROUP...]      GROUP: base25 pair25 sens25 tools25 layers25 base35 base50 base71 base100 fbar25
 #   python3 scripts/numisheet93_report.py OUT         # writes docs/validation/numisheet93.md + SVG
 set -euo pipefail
 out=${1:-out/numisheet93}
@@ -57,6 +57,13 @@ for g in $groups; do
                  run "${m}_ss71" material="\"$m\"" yield_kind='"hill48"' cells=71; done ;;
     base100) for m in aluminium_1993 steel; do
                  run "${m}_ss100" material="\"$m\"" yield_kind='"hill48"' cells=100; done ;;
+    tools25) for m in aluminium_1993 steel; do   # tool radii by +-0.5 mm (our tolerance)
+                 for side in minus:7.5 plus:8.5; do
+                     run "${m}_ss25_die_radius_${side%%:*}" material="\"$m\"" yield_kind='"hill48"' cells=25 die_radius=${side##*:}
+                     run "${m}_ss25_punch_radius_${side%%:*}" material="\"$m\"" yield_kind='"hill48"' cells=25 punch_radius=${side##*:}
+                 done; done ;;
+    layers25) for m in aluminium_1993 steel; do
+                 run "${m}_ss25_layers2" material="\"$m\"" yield_kind='"hill48"' cells=25 layers=2; done ;;
     fbar25)  for m in aluminium_1993 steel; do
                  run "${m}_hex25" material="\"$m\"" yield_kind='"hill48"' cells=25 element='"hexahedron"'; done ;;
     *) echo "unknown group $g" >&2; exit 2 ;;
