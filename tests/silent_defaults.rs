@@ -59,7 +59,11 @@ fn default_small_strain_past_its_range_stops_with_the_fix() {
 fn square_cup_refuses_a_negative_travel() {
     let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/square_cup.rhai");
     let out = common::TestDir::new(&format!("tribo-cup-travel-{}", std::process::id()));
-    for (set, shown) in [("travel=-5", "travel = -5"), ("mu=-0.1", "mu = -0.1")] {
+    for (set, shown) in [
+        ("travel=-5", "travel = -5"),
+        ("mu=-0.1", "mu = -0.1"),
+        ("die_radius=-8", "die_radius = -8"),
+    ] {
         let run = std::process::Command::new(env!("CARGO_BIN_EXE_tribo"))
             .arg("run")
             .arg(&script)
