@@ -24,9 +24,11 @@ run() { # name, then --set arguments
     if [[ -d "$dir" ]]; then echo "skip $name (done or under way)"; return; fi
     mkdir -p "$dir"
     echo "run  $name: $*"
-    local sets=() defaults=(variant='"benchmark"' layers=1 charts=false)
-    # The solid-shell unless the run names its element (a --set may name a variable once).
+    local sets=() defaults=(variant='"benchmark"' charts=false)
+    # One solid-shell layer unless the run names its element or layers (a --set may name
+    # a variable once).
     [[ " $* " == *" element="* ]] || defaults+=(element='"solid_shell"')
+    [[ " $* " == *" layers="* ]] || defaults+=(layers=1)
     for s in "${defaults[@]}" "$@"; do
         sets+=(--set "$s")
     done
