@@ -72,13 +72,13 @@ fn a_second_tab_lists_every_candidate() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let script = dir.join("drag.rhai");
-    std::fs::write(&script, common::pty::drag_scene(4, 30, 0, "sim.run();")).unwrap();
+    std::fs::write(&script, common::pty::drag_scene(8, 30, 0, "sim.run();")).unwrap();
     let mut s = Session::start(BIN, &script, &dir.join("out"), "xterm");
     let at = s.expect(0, "tribo> ");
-    // The Simulation methods starting with `tool_`: force(s), offset(s), position. Cycling
-    // would have shown `tool_force` and `tool_forces` only.
+    // The Simulation methods starting with `tool_`: force, offset, position. Cycling showed
+    // `tool_force`, then `tool_offset` in its place, never the third.
     s.send(b"print(\"n = \" + sim.tool_\t\t");
-    for name in ["tool_forces", "tool_offsets", "tool_position"] {
+    for name in ["tool_force", "tool_offset", "tool_position"] {
         s.expect(at, name);
     }
     // The line is still the typed prefix: finishing it by hand runs.
