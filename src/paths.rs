@@ -331,8 +331,16 @@ impl ReadPolicy {
         }
         let canonical = match lexical.canonicalize() {
             Ok(c) => c,
+            // A link that leads outside refuses alike whether its target exists or not
+            // (issue 52: "no such file" for a dangling one told a script that an outside
+            // file was missing).
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                return Err(Error::Input(format!("{what} \"{given}\": no such file")))
+                return Err(match follow_links(&lexical, 0) {
+                    Some(target) if self.inside(&target) => {
+                        Error::Input(format!("{what} \"{given}\": no such file"))
+                    }
+                    _ => self.outside_error(given, what),
+                })
             }
             Err(e) => return Err(Error::Input(format!("{what} \"{given}\": {e}"))),
         };
@@ -393,6 +401,35 @@ impl ReadPolicy {
         })?;
         Ok((path, bytes))
     }
+}
+
+/// Where `path` (absolute, normalized) leads when the links along it are followed, as far
+/// as it exists: the part past the first missing component is kept as written. `None` for a
+/// chain of more than 40 links (the kernel's own bound) or an unreadable link. For a path
+/// that `canonicalize` cannot resolve, so that a dangling link is judged by its target.
+fn follow_links(path: &Path, hops: usize) -> Option<PathBuf> {
+    if hops > 40 {
+        return None;
+    }
+    let mut out = PathBuf::new();
+    let mut parts = path.components();
+    while let Some(c) = parts.next() {
+        out.push(c);
+        match std::fs::symlink_metadata(&out) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                let target = std::fs::read_link(&out).ok()?;
+                let parent = out.parent().unwrap_or(Path::new("/"));
+                let joined = normalize(&parent.join(target))?.join(parts.as_path());
+                return follow_links(&normalize(&joined)?, hops + 1);
+            }
+            Ok(_) => {}
+            Err(_) => {
+                out.push(parts.as_path());
+                return normalize(&out);
+            }
+        }
+    }
+    Some(out)
 }
 
 /// `path` with `.` dropped and `..` applied lexically; `None` if `..` climbs above the root.

@@ -211,3 +211,73 @@ fn a_checkpoint_of_another_material_or_friction_law_is_refused() {
         .restore(&mut sim)
         .unwrap();
 }
+
+/// A block pressed on a plane and dragged, with a script friction law of body `law` (the
+/// function's text, after `|work, slip, pressure|`), `before` above it (declarations, a
+/// comment); checkpoints every 2 increments of 4.
+fn law_scene(before: &str, law: &str) -> String {
+    format!(
+        r#"{before}
+let mesh = block([0, 0, 0], [10, 10, 2], [3, 3, 1]);
+let sim = simulation(mesh, linear_elastic(1000.0, 0.3));
+sim.add_tool(tool("floor", plane([0, 0, 0], [0, 0, 1])).friction(|work, slip, pressure| {law}), "z-");
+sim.load("z+", [0.0, 0.0, -100.0], [[0.0, 0.0], [1.0, 1.0]]);
+sim.prescribe("z+", "x", [[0.0, 0.0], [1.0, 0.0], [2.0, 0.5]]);
+sim.fix("z+", "y");
+sim.settings(#{{ end_time: 2.0, increments: 4, checkpoint_every: 2 }});
+sim.run();
+"#
+    )
+}
+
+/// Issue 52: a script friction law's body was not in the fingerprint (only its mu at zero
+/// work), so a restart with another function of the same mu at zero work was accepted. Each
+/// changed law below has mu = 0.2 at zero work; the same law after an unrelated edit of the
+/// script (a comment line moving it down) is still accepted.
+#[test]
+fn a_restart_with_another_script_friction_law_body_is_refused() {
+    let dir = common::TestDir::new(&format!("tribo-law-source-{}", std::process::id()));
+    std::fs::create_dir_all(&*dir).unwrap();
+    let run = |name: &str, text: &str, restart: Option<std::path::PathBuf>| {
+        let script = dir.join(format!("{name}.rhai"));
+        std::fs::write(&script, text).unwrap();
+        let host = tribo::script::HostOptions {
+            out_dir: dir.join(name),
+            warnings: false,
+            script_print: false,
+            restart,
+            ..Default::default()
+        };
+        tribo::script::run_file(&script, &[], &host).map_err(|e| e.to_string())
+    };
+    let law = "0.2 + 0.01 * work";
+    run("first", &law_scene("let k = 0.01;", law), None).unwrap();
+    let ck = dir.join("first/checkpoints/checkpoint_0002.json");
+    assert!(ck.is_file());
+    let again =
+        |name: &str, before: &str, law: &str| run(name, &law_scene(before, law), Some(ck.clone()));
+    again("same", "let k = 0.01;", law).unwrap();
+    again("moved", "let k = 0.01;\n// an edit above the law\n", law).unwrap();
+    for (name, before, other) in [
+        ("body", "let k = 0.01;", "0.2 + 0.02 * work"),
+        ("slip", "let k = 0.01;", "0.2 + 0.01 * work + 0.001 * slip"),
+        ("captured", "let k = 0.02;", "0.2 + k * work"),
+    ] {
+        // The captured case: the first run's law must read k too.
+        let reference = if name == "captured" {
+            let first = run("first-k", &law_scene("let k = 0.01;", other), None);
+            first.unwrap();
+            dir.join("first-k/checkpoints/checkpoint_0002.json")
+        } else {
+            ck.clone()
+        };
+        let err = run(name, &law_scene(before, other), Some(reference)).unwrap_err();
+        assert!(
+            err.contains("model.friction_hashes[0]")
+                && err.contains("friction law of tool 'floor'")
+                && err.contains("script function |work, slip, pressure|")
+                && err.contains("source fnv1a"),
+            "{name}: {err}"
+        );
+    }
+}

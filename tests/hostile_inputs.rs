@@ -248,11 +248,29 @@ fn a_run_crawling_at_the_minimum_step_stops_with_the_reason() {
         common::run_script_in("hostile", "crawl", src, &["--max-increments", "2000"]);
     assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains(
-            "the run crawls at the minimum step: 100 increments in a row at dt_min = 1e-6"
-        ) && err.contains("(setting dt_min)")
-            && err.contains("reached t = "),
+        err.contains("(setting dt_min)") && err.contains("reached t = "),
         "{err}"
+    );
+    // Issue 52: the reason first, on a short line of its own (it was one line of ~900
+    // characters); the figures, the rule and the advice on the lines after it.
+    let first = err
+        .lines()
+        .find(|l| l.starts_with("error:"))
+        .expect("an error line");
+    let path = dir.join("crawl.rhai").display().to_string();
+    assert!(
+        first.ends_with(
+            "no convergence: the run crawls at the minimum step dt_min = 1e-6: 100 increments in a row"
+        ),
+        "{err}"
+    );
+    // Without the script's path (a temporary folder's), the line is the host's prefix
+    // (`error: script error: :8:5: Runtime error: no convergence: `, 58 characters) and the
+    // 73-character reason: within 140 (it was ~900).
+    assert!(
+        first.replace(&path, "").len() <= 140,
+        "{} characters: {first}",
+        first.len()
     );
     let out = dir.join("out");
     let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");

@@ -62,3 +62,28 @@ fn completion_multi_line_input_and_help_in_a_terminal() {
     s.quit();
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 52: TAB on a prefix that several names share inserted the first of them and cycled
+/// through the others one TAB at a time (rustyline's default), so the choice was never
+/// shown. Now the first TAB completes what they share and the second lists them all.
+#[test]
+fn a_second_tab_lists_every_candidate() {
+    let dir = std::env::temp_dir().join(format!("tribo-repl-list-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("drag.rhai");
+    std::fs::write(&script, common::pty::drag_scene(8, 30, 0, "sim.run();")).unwrap();
+    let mut s = Session::start(BIN, &script, &dir.join("out"), "xterm");
+    let at = s.expect(0, "tribo> ");
+    // The Simulation methods starting with `tool_`: force, offset, position. Cycling showed
+    // `tool_force`, then `tool_offset` in its place, never the third.
+    s.send(b"print(\"n = \" + sim.tool_\t\t");
+    for name in ["tool_force", "tool_offset", "tool_position"] {
+        s.expect(at, name);
+    }
+    // The line is still the typed prefix: finishing it by hand runs.
+    s.send(b"position(\"roller\").len())\r");
+    s.expect(at, "n = 3");
+    s.quit();
+    let _ = std::fs::remove_dir_all(&dir);
+}

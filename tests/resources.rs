@@ -188,9 +188,8 @@ fn a_growing_array_stops_at_its_bound_naming_the_option() {
         &[],
     );
     assert_eq!(o.code, 0, "{}", o.stderr);
-    // Maps: an entry set by a call is checked against --max-map-size (Rhai checks a map
-    // assigned by index, `m[key] = v`, for the value only; such growth is bounded by the
-    // operation and memory limits).
+    // Maps: an entry set by a call is checked against --max-map-size (Rhai's own check;
+    // growth by index assignment: `a_map_grown_by_index_assignment_stops_at_its_bound`).
     let o = run(
         "map-low",
         "let m = #{};\nfor i in 0..2000 { m.set(`k${i}`, i); }\n",
@@ -202,6 +201,46 @@ fn a_growing_array_stops_at_its_bound_naming_the_option() {
         "{}",
         o.stderr
     );
+}
+
+#[test]
+fn a_map_grown_by_index_assignment_stops_at_its_bound() {
+    // Issue 52: Rhai checks `m[key] = v` for the value only, so this loop grew the map until
+    // the operation limit (50 M operations, some millions of entries). The script-time limit
+    // is 60 s so that a regression fails with that limit's message rather than later.
+    let bounded = ["--max-map-size", "1000", "--max-script-seconds", "60"];
+    let o = run(
+        "map-index",
+        "let m = #{};\nlet i = 0;\nloop { m[`k${i}`] = i; i += 1; }\n",
+        &bounded,
+    );
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("s.rhai:3:")
+            && o.stderr.contains("more than 1 000 entries in one value")
+            && o.stderr.contains("--max-map-size"),
+        "{}",
+        o.stderr
+    );
+    // A map nested in another (counted with it, at every 64th read of a map).
+    let o = run(
+        "map-nested",
+        "let m = #{ inner: #{} };\nlet i = 0;\nloop { m.inner[`k${i}`] = i; i += 1; }\n",
+        &bounded,
+    );
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("more than 1 000 entries in one value"),
+        "{}",
+        o.stderr
+    );
+    // Within the bound, the same loop runs to its end and the map holds every entry.
+    let o = run(
+        "map-index-ok",
+        "let m = #{};\nfor i in 0..1000 { m[`k${i}`] = i; }\nif m.len() != 1000 { throw \"lost entries\"; }\n",
+        &bounded,
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
 }
 
 const SCENE: &str = r#"
@@ -343,3 +382,70 @@ fn a_stop_on_the_output_cap_writes_its_summary_and_final_checkpoint() {
         "final checkpoint"
     );
 }
+
+/// Issue 52: `--max-memory-mb` was checked only while the script's own code ran, so a
+/// simulation could pass it by any amount (a 26^3 cube peaked at 2 290 MiB against 2 000).
+/// A block compressed in 8 increments, behind a script ballast array that keeps the
+/// process above the mesh's pre-run estimate: a run without the simulation and a full run
+/// measure the peak before and after the solver's allocations, and a limit halfway stops
+/// the limited run during `sim.run()`, with its summary and final checkpoint.
+#[test]
+fn the_memory_limit_stops_a_running_simulation() {
+    let script = |run_it: bool| {
+        format!(
+            "let ballast = [];\nballast.pad(8000000, 1.0);\n\
+             let mesh = block([0, 0, 0], [1, 1, 1], [MESH, MESH, MESH]);\n\
+             let sim = simulation(mesh, linear_elastic(1000.0, 0.3));\n\
+             sim.fix(\"z-\", \"xyz\");\n\
+             sim.prescribe(\"z+\", \"z\", [[0.0, 0.0], [1.0, -0.01]]);\n\
+             sim.settings(#{{ increments: 8, output_every: 0 , checkpoint_every: 100 }});\n{}",
+            if run_it { "sim.run();\n" } else { "" }
+        )
+        .replace("MESH", &MEMORY_MESH.to_string())
+    };
+    let arrays = ["--max-array-size", "8388608"];
+    let setup = run("mem-setup", &script(false), &arrays);
+    assert_eq!(setup.code, 0, "{}", setup.stderr);
+    let full = run("mem-full", &script(true), &arrays);
+    assert_eq!(full.code, 0, "{}", full.stderr);
+    let mib = |b: u64| b >> 20;
+    // The solver's own allocations must leave room for a limit strictly between.
+    assert!(
+        mib(full.peak) >= mib(setup.peak) + 8,
+        "peaks {} and {} MiB",
+        mib(setup.peak),
+        mib(full.peak)
+    );
+    let limit = (mib(setup.peak) + mib(full.peak)) / 2;
+    let mut extra = arrays.to_vec();
+    let limit_text = limit.to_string();
+    extra.extend(["--max-memory-mb", &limit_text]);
+    let o = run("mem-stop", &script(true), &extra);
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    let message = format!("over the limit of {limit} MiB (raise it with --max-memory-mb)");
+    assert!(
+        o.stderr.contains("the run's memory reached") && o.stderr.contains(&message),
+        "{}",
+        o.stderr
+    );
+    // Stopped inside the run, short of its 8 increments, as other stops are recorded.
+    let out = o.dir.join("out");
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(summary["status"], "stopped");
+    assert!(
+        summary["stop_reason"].as_str().unwrap().contains(&message),
+        "{}",
+        summary["stop_reason"]
+    );
+    assert!(summary["increments"].as_u64().unwrap() < 8);
+    assert!(
+        out.join("checkpoints/final.json").is_file(),
+        "final checkpoint"
+    );
+}
+
+/// Cells per side of the memory test's cube (729 nodes, estimated at 90 MiB before the run,
+/// under the ballast's 135 MiB): its eight increments raise the process's peak from 135 to
+/// 169 MiB (measured on the 2-core test machine), well over the 8 MiB the test needs.
+const MEMORY_MESH: usize = 8;

@@ -254,13 +254,24 @@ fn json_reads_outside_do_not_reveal_what_exists() {
     assert_eq!(message(&existing), message(&missing));
     assert_eq!(message("/etc/passwd"), message("/etc/no-such-file"));
     message("../outside/secret.json");
-    // A link in the script's folder pointing outside is refused too.
+    // A link in the script's folder pointing outside is refused too, with the same message
+    // whether its target exists or not (issue 52: a dangling link said "no such file").
     symlink(
         t.outside().join("secret.json"),
         t.script_dir().join("link.json"),
     )
     .unwrap();
-    message("link.json");
+    symlink(
+        t.outside().join("nothing-here.json"),
+        t.script_dir().join("dangling.json"),
+    )
+    .unwrap();
+    assert_eq!(message("link.json"), message("dangling.json"));
+    // A dangling link inside the folder is just a missing file.
+    symlink("nothing.json", t.script_dir().join("inner.json")).unwrap();
+    let (code, _, err) = t.run("bezier_surface_json(\"inner.json\");", &[]);
+    assert_ne!(code, 0);
+    assert!(err.contains("\"inner.json\": no such file"), "{err}");
 }
 
 #[test]

@@ -194,8 +194,10 @@ pub enum FrictionLaw {
     /// A Rust function of the node's state, called once per node per converged increment.
     Function(Arc<dyn Fn(&FrictionInput) -> f64 + Send + Sync>),
     /// Set from outside after each converged increment (a script function: the script layer
-    /// calls it, so that nothing below it knows Rhai). `initial` is mu of a virgin node.
-    External { initial: f64 },
+    /// calls it, so that nothing below it knows Rhai). `initial` is mu of a virgin node;
+    /// `source` says what the function is (the script layer's description of its source
+    /// text), so that the checkpoint's fingerprint of the law changes with its body.
+    External { initial: f64, source: String },
     /// mu as a Bernstein polynomial of the TOOL's accumulated frictional work per area at
     /// the node's foot: theta = min(w_tool / work_cut, 1) (issue 53: a coating wearing over
     /// the strokes raises mu). The law's work is the tool's work per area (force/length),
@@ -238,7 +240,7 @@ impl FrictionLaw {
     /// mu of a node that has done no frictional work.
     pub fn initial_mu(&self, area: f64) -> f64 {
         match self {
-            FrictionLaw::External { initial } => *initial,
+            FrictionLaw::External { initial, .. } => *initial,
             FrictionLaw::ToolWork(law) => law.mu_of_theta(0.0),
             other => other
                 .mu(&FrictionInput {
@@ -269,8 +271,8 @@ impl FrictionLaw {
                 l.measure.name()
             ),
             FrictionLaw::Function(_) => "function of the node's state".into(),
-            FrictionLaw::External { initial } => {
-                format!("script function (mu at zero work = {initial})")
+            FrictionLaw::External { initial, source } => {
+                format!("{source} (mu at zero work = {initial})")
             }
             FrictionLaw::ToolWork(l) => format!(
                 "Bernstein of the tool's work per area, degree {} control points {:?}, work_cut = {}",

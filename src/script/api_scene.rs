@@ -94,8 +94,19 @@ fn register_friction(engine: &mut Engine, host: std::rc::Rc<super::HostOptions>)
                 &format!("friction function of tool '{}' at zero work", t.name),
                 initial,
             ))?;
+            let source = {
+                let sources = host.sources.borrow();
+                let text = ctx.call_source().and_then(|name| sources.get(name));
+                let p = ctx.call_position();
+                super::law_source::describe(
+                    &law,
+                    text.map(|t| &**t),
+                    p.line().unwrap_or(0),
+                    p.position().unwrap_or(0),
+                )
+            };
             host.script_laws.borrow_mut().insert(t.name.clone(), law);
-            t.friction = FrictionLaw::External { initial };
+            t.friction = FrictionLaw::External { initial, source };
             Ok(t.clone())
         },
     );

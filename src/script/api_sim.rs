@@ -342,6 +342,11 @@ impl SimState {
             };
             refuse_free_body(&model)?;
             let mut sim = lift(Simulation::new(model))?;
+            // The run's memory bound rides on its stop request (polled at every Newton
+            // iteration), so a run that passes it stops like an interrupted one.
+            self.host
+                .interrupt
+                .set_memory_limit(self.host.limits.max_memory);
             sim.set_interrupt(self.host.interrupt.clone());
             self.model = None;
             let frame_times = match self.host.restart.as_ref() {
@@ -391,7 +396,14 @@ impl SimState {
                 self.failure = None;
                 Ok(report)
             }
-            Err(Error::Interrupted(why)) => Err(interrupted(&why)),
+            Err(Error::Interrupted(why)) if self.host.interrupt.is_raised() => {
+                Err(interrupted(&why))
+            }
+            // The memory bound (the flag is down): a stop, recorded as such by the host.
+            Err(Error::Interrupted(why)) => Err(Box::new(rhai::EvalAltResult::ErrorTerminated(
+                Dynamic::from(why),
+                rhai::Position::NONE,
+            ))),
             Err(err) => {
                 let mut err = err;
                 let (kind, cycling) = err.failure();

@@ -3,7 +3,9 @@
 //!
 //! * **Memory**: a mesh is refused before it is allocated when its estimated need is over the
 //!   limit ([`Limits::check_mesh`]); while the script itself runs, the process's peak
-//!   resident memory (`getrusage`) is checked every [`CHECK_EVERY`] operations.
+//!   resident memory (`getrusage`) is checked every [`CHECK_EVERY`] operations, and while
+//!   the simulation runs, at every Newton iteration (the run's stop request carries the
+//!   bound: [`crate::interrupt::Interrupt::memory_over`]).
 //! * **Script wall time**: time spent in the script's own code, not in the simulation
 //!   (`sim.run()`/`sim.step()` are timed apart and subtracted), checked with the memory.
 //! * **Increments** and **output size**: see [`Limits::max_increments`] and
@@ -14,6 +16,11 @@
 //!   n entries one `push` at a time costs n²/2 visits: about 2.4 ns each on the test
 //!   machine, 5 s for 65 536 entries, hours for the 4 194 304 that were allowed before. The
 //!   bound is what keeps such a loop short; [`DEFAULT_MAX_ARRAY`] says why it is enough.
+//!   Rhai does not check a map that grows by index assignment (`m["k" + i] = i` checks the
+//!   new entry, not the map), so the engine also checks a map each time a script variable
+//!   holding one is read ([`map_over_bound`]): its own entries at every read (O(1)), its
+//!   nested maps counted at every [`CHECK_EVERY`]-th read of a map (O(entries)), so the
+//!   counting costs at most 1/64 of an entry visit per entry and read.
 //! * **A stop request** (SIGINT/SIGTERM, [`crate::interrupt::Interrupt`]) is polled with the
 //!   clock, so that a script busy in its own code (a loop, a script friction law) stops at
 //!   the first signal and the run records its stop as interrupted.
@@ -91,18 +98,8 @@ pub fn machine_memory() -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// Peak resident memory of this process so far, in bytes (`getrusage`, `ru_maxrss`): it
-/// only grows, so it says whether the limit was ever passed.
-pub fn peak_memory() -> Option<u64> {
-    // SAFETY: getrusage writes into the zeroed struct it is given and has no other effect.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    let rc = unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) };
-    (rc == 0).then(|| usage.ru_maxrss.max(0) as u64 * 1024)
-}
-
-fn mib(bytes: u64) -> String {
-    format!("{:.0} MiB", bytes as f64 / (1u64 << 20) as f64)
-}
+use crate::interrupt::mib;
+pub use crate::interrupt::peak_memory;
 
 impl Limits {
     /// Refuses a mesh of `nodes` nodes whose estimated memory is over the limit, before it
@@ -189,6 +186,38 @@ pub fn progress_check(
             mib(limits.max_memory)
         )),
         _ => None,
+    }
+}
+
+/// Whether `value` (a script variable being read) is a map over the bound of
+/// [`Limits::max_map`]: its own entries are compared at every read, the entries of its nested
+/// maps (inside maps and arrays, as Rhai counts them) at every [`CHECK_EVERY`]-th map read
+/// (`reads` counts them). Rhai's own check misses a map grown by index assignment (module
+/// docs); this one stops such a loop at its next read of the map.
+pub fn map_over_bound(limits: &Limits, value: &rhai::Dynamic, reads: &Cell<u64>) -> bool {
+    let Some(map) = value.read_lock::<rhai::Map>() else {
+        return false;
+    };
+    if map.len() > limits.max_map {
+        return true;
+    }
+    let n = reads.get().wrapping_add(1);
+    reads.set(n);
+    n % CHECK_EVERY == 0 && nested_map_entries(&map) > limits.max_map
+}
+
+/// Entries of `map` and of every map inside it (through maps and arrays).
+fn nested_map_entries(map: &rhai::Map) -> usize {
+    map.len() + map.values().map(inner_map_entries).sum::<usize>()
+}
+
+fn inner_map_entries(value: &rhai::Dynamic) -> usize {
+    if let Some(map) = value.read_lock::<rhai::Map>() {
+        nested_map_entries(&map)
+    } else if let Some(array) = value.read_lock::<rhai::Array>() {
+        array.iter().map(inner_map_entries).sum()
+    } else {
+        0
     }
 }
 

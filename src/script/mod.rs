@@ -18,6 +18,7 @@ mod api_steps;
 mod api_strokes;
 mod api_tools;
 mod convert;
+mod law_source;
 pub mod limits;
 pub(crate) mod record;
 pub mod repl;
@@ -47,6 +48,9 @@ pub struct HostOptions {
     pub defer_run: Rc<std::cell::Cell<bool>>,
     /// Script friction laws by tool name (`tool.friction(|work, slip, pressure| ...)`).
     pub script_laws: Rc<std::cell::RefCell<std::collections::BTreeMap<String, rhai::FnPtr>>>,
+    /// The text of every script compiled for this host, by the source name its AST carries
+    /// (after `--set`): where a script friction law's source is read (module `law_source`).
+    pub sources: Rc<std::cell::RefCell<std::collections::BTreeMap<String, Rc<str>>>>,
     /// `tribo run --restart FILE`: the first simulation the script starts continues from
     /// this checkpoint.
     pub restart: Option<PathBuf>,
@@ -126,6 +130,7 @@ impl Default for HostOptions {
             max_operations: 50_000_000,
             defer_run: Rc::new(std::cell::Cell::new(false)),
             script_laws: Rc::default(),
+            sources: Rc::default(),
             restart: None,
             restart_used: Rc::default(),
             warnings: true,
@@ -163,6 +168,16 @@ pub fn engine(host: &HostOptions, script_dir: Option<&Path>) -> Engine {
     let interrupt = host.interrupt.clone();
     engine.on_progress(move |ops| {
         limits::progress_check(&limits, &clock, &interrupt, ops).map(Dynamic::from)
+    });
+    // Maps grown by index assignment, which Rhai's size check misses (module `limits`).
+    let (map_limits, map_reads) = (host.limits.clone(), std::cell::Cell::new(0u64));
+    // `on_var` is marked deprecated only as "volatile" (Rhai's own note): it is supported.
+    #[allow(deprecated)]
+    engine.on_var(move |name, _, ctx| match ctx.scope().get(name) {
+        Some(value) if limits::map_over_bound(&map_limits, value, &map_reads) => Err(Box::new(
+            EvalAltResult::ErrorDataTooLarge("Size of object map".into(), Position::NONE),
+        )),
+        _ => Ok(None),
     });
     let host = Rc::new(host);
     api_scene::register(&mut engine, host.clone());
@@ -324,6 +339,11 @@ pub fn parse_override(text: &str) -> Result<(String, Dynamic)> {
 
 /// Compiles a script file, naming the file in errors.
 pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
+    compile_source(engine, path).map(|(ast, _)| ast)
+}
+
+/// [`compile`], also returning the script's text.
+fn compile_source(engine: &Engine, path: &Path) -> Result<(AST, String)> {
     let source =
         crate::paths::read_named_text(path, crate::paths::DEFAULT_MAX_READ_BYTES, "script")?;
     let file = path.display().to_string();
@@ -337,7 +357,14 @@ pub fn compile(engine: &Engine, path: &Path) -> Result<AST> {
         ))
     })?;
     ast.set_source(file);
-    Ok(ast)
+    Ok((ast, source))
+}
+
+/// Keeps `text`, the script compiled as `path`, where a script friction law's source is
+/// looked up (module `law_source`).
+fn remember_source(host: &HostOptions, path: &Path, text: String) {
+    let name = path.display().to_string();
+    host.sources.borrow_mut().insert(name, text.into());
 }
 
 /// Runs a script file to its end.
@@ -351,13 +378,14 @@ pub fn run_file(path: &Path, overrides: &[(String, Dynamic)], host: &HostOptions
     host.simulations.clear();
     host.late_sets.borrow_mut().clear();
     let engine = engine(host, path.parent());
-    let ast = compile(&engine, path)?;
+    let (ast, source) = compile_source(&engine, path)?;
     // The --allow-read folders exist (the engine would otherwise refuse every read quietly).
     read_policy(host, path.parent())?;
     // Held to the end of the run: a second run into the same folder is refused.
     let _lock = crate::output::FolderLock::acquire(&host.out_dir)?;
     prepare_output_folder(&host.out_dir, host.earlier_outputs)?;
-    let ast = apply_overrides(&engine, ast, overrides, path)?;
+    let (ast, text) = overridden(&engine, ast, overrides, path)?;
+    remember_source(host, path, text.unwrap_or(source));
     let mut scope = Scope::new();
     let outcome = engine
         .run_ast_with_scope(&mut scope, &ast)
@@ -398,8 +426,18 @@ pub fn apply_overrides(
     overrides: &[(String, Dynamic)],
     path: &Path,
 ) -> Result<AST> {
+    overridden(engine, ast, overrides, path).map(|(ast, _)| ast)
+}
+
+/// [`apply_overrides`], also returning the script's text after them (`None`: no override).
+fn overridden(
+    engine: &Engine,
+    ast: AST,
+    overrides: &[(String, Dynamic)],
+    path: &Path,
+) -> Result<(AST, Option<String>)> {
     if overrides.is_empty() {
-        return Ok(ast);
+        return Ok((ast, None));
     }
     for (i, (name, _)) in overrides.iter().enumerate() {
         if overrides[..i].iter().any(|(n, _)| n == name) {
@@ -461,7 +499,7 @@ pub fn apply_overrides(
         .compile(&patched)
         .map_err(|e| Error::Script(format!("{file}: after --set: {e}")))?;
     ast.set_source(file);
-    Ok(ast)
+    Ok((ast, Some(patched)))
 }
 
 /// The names of the script's top-level `let NAME = ...;` lines (what `--set` can override).

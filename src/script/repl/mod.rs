@@ -15,13 +15,14 @@
 //! done here rather than in rustyline's validator so that it works the same when the input
 //! is not a terminal. TAB completion ([`complete`]) and `:help NAME` ([`help`]) take their
 //! names from the engine's registrations ([`catalogue`]); values are shown by [`display`].
+//! TAB completes what the candidates share and a second TAB lists every candidate.
 
 mod catalogue;
 mod complete;
 mod display;
 mod help;
 
-use super::{compile, describe_error, engine, HostOptions, DEFERRED};
+use super::{compile_source, describe_error, engine, remember_source, HostOptions, DEFERRED};
 use crate::Result;
 use rhai::{Dynamic, Engine, EvalAltResult, ParseErrorType, Scope};
 use rustyline::error::ReadlineError;
@@ -36,7 +37,8 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
     let engine = engine(host, script.and_then(|p| p.parent()));
     let mut scope = Scope::new();
     if let Some(path) = script {
-        let ast = compile(&engine, path)?;
+        let (ast, source) = compile_source(&engine, path)?;
+        remember_source(host, path, source);
         host.defer_run.set(true);
         let loaded = engine.run_ast_with_scope(&mut scope, &ast);
         host.defer_run.set(false);
@@ -60,7 +62,7 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
     }
     println!("tribo repl: type :help for help, :quit to leave");
     let mut editor: rustyline::Editor<complete::ReplHelper, rustyline::history::DefaultHistory> =
-        rustyline::Editor::new()
+        rustyline::Editor::with_config(editor_config())
             .map_err(|e| crate::Error::Input(format!("cannot start the line editor: {e}")))?;
     let catalogue = catalogue::Catalogue::of(&engine);
     editor.set_helper(Some(complete::ReplHelper {
@@ -114,6 +116,15 @@ pub fn run(script: Option<&Path>, host: &HostOptions) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The line editor's settings: TAB completes the part all candidates share and a second
+/// TAB lists them all (as bash does), rather than rustyline's default of inserting the first
+/// candidate and cycling through the others one TAB at a time, which hid the choice.
+fn editor_config() -> rustyline::Config {
+    rustyline::Config::builder()
+        .completion_type(rustyline::CompletionType::List)
+        .build()
 }
 
 /// What a `:command` prints; `None` for `:quit`.

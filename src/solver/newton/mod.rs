@@ -113,16 +113,21 @@ impl<'a> Newton<'a> {
         }
     }
 
-    /// `Error::Interrupted` once a stop was requested; the committed state stays.
+    /// `Error::Interrupted` once a stop was requested, or once the process's peak memory
+    /// passed the run's bound (`Interrupt::memory_over`: the flag stays down, so callers
+    /// tell the two apart); the committed state stays.
     pub(crate) fn check_interrupt(&self) -> Result<()> {
-        if self.interrupt.is_raised() {
-            return Err(Error::Interrupted(format!(
-                "{}; the increment from t = {} was abandoned",
-                self.interrupt.reason(),
-                self.time
-            )));
-        }
-        Ok(())
+        let why = if self.interrupt.is_raised() {
+            self.interrupt.reason()
+        } else if let Some(over) = self.interrupt.memory_over() {
+            over
+        } else {
+            return Ok(());
+        };
+        Err(Error::Interrupted(format!(
+            "{why}; the increment from t = {} was abandoned",
+            self.time
+        )))
     }
 
     /// Committed displacement of a node.

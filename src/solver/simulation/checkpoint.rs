@@ -143,7 +143,7 @@ pub struct Fingerprint {
 
 /// 64-bit FNV-1a, written as 16 hex digits (JSON numbers would lose the high bits).
 /// O(bytes).
-fn fnv1a(bytes: impl IntoIterator<Item = u8>) -> String {
+pub fn fnv1a(bytes: impl IntoIterator<Item = u8>) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in bytes {
         h ^= u64::from(b);

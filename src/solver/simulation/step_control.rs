@@ -130,14 +130,18 @@ impl IncrementMeasures {
 /// step doubles after an easy one), far fewer than this.
 pub const CRAWL_INCREMENTS: usize = 100;
 
-/// The reason of a crawl stop: the setting, the increments at it, the time reached.
+/// The reason of a crawl stop: the setting, the increments at it, the time reached. The
+/// reason comes first, on a line of its own (it is what a person reads of a stop); the
+/// figures, the rule and what to do follow on indented lines.
 pub fn crawl_message(dt_min: f64, increments: usize, time: f64, end_time: f64) -> String {
     format!(
-        "the run crawls at the minimum step: {increments} increments in a row at dt_min = {dt_min:e} \
-         (setting dt_min) reached t = {time:.6e} of end_time = {end_time}, and the rest would take up \
-         to {} more; stopped (the rule: {CRAWL_INCREMENTS} increments in a row held at dt_min by an \
-         exceeded limit or a cutback). Look at the last state (checkpoints/final.json, the column \
-         step_limit of history.csv) for what holds the step back; raise dt_min to go on in coarser steps",
+        "the run crawls at the minimum step dt_min = {dt_min:e}: {increments} increments in a row\n  \
+         it reached t = {time:.6e} of end_time = {end_time}; the rest would take up to {} more \
+         increments\n  \
+         the rule: a stop after {CRAWL_INCREMENTS} increments in a row held at dt_min (setting \
+         dt_min) by an exceeded limit or a cutback\n  \
+         look at the last state (checkpoints/final.json, the column step_limit of history.csv) \
+         for what holds the step back; raise dt_min to go on in coarser steps",
         ((end_time - time) / dt_min).ceil().max(0.0)
     )
 }
