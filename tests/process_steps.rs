@@ -423,7 +423,6 @@ fn the_u_channel_springs_open_once_released() {
 /// checks; physics says only that the channel opens here too (by how much more than with
 /// isotropic hardening is measured in docs/u-channel-springback.md, not asserted).
 #[test]
-#[ignore = "issue 47: the release with Chaboche hardening still stops on a singular Jacobian; the slipping-node unit rows that fixed it broke a pulled block's friction and the global finite-difference tests, so they did not land (docs/u-channel-springback.md, \"Not done\")"]
 fn the_u_channel_with_kinematic_hardening_releases_and_springs_open() {
     let angles = u_channel_springs_open(&["kinematic=true"]);
     assert_eq!(angles["kinematic"], true, "{angles}");
