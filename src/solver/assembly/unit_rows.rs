@@ -52,12 +52,14 @@
 //! bit for bit (the finite-difference tests, whose states are off the cone, cannot move).
 //!
 //! The threshold. On the cone the diagonal `(c - 1)/r` is the round-off of a quotient of
-//! norms, `|c - 1| <= ~10 eps = 2e-15` for a multiplier stored on the cone (the U-channel's:
-//! exactly 0 and 8.5e-20 r); the equilibrium entries off the prescribed row are
-//! `-c t_i t_j`, exactly 0 for `lambda_j = 0`. [`EMPTY_COLUMN_TOLERANCE`] = 1e-12 leaves
-//! 500 times that round-off for a state a few operations off the cone, and is 100 times
-//! below the symmetric LU's pivot tolerance (`PIVOT_TOLERANCE` = 1e-10): a column it keeps
-//! is one the factorization can pivot on.
+//! norms, `|c - 1| <= ~10 eps = 2e-15` for a multiplier stored on the cone (the U-channel's
+//! holder node: exactly 0; its neighbour -8.5e-20); the equilibrium entries off the
+//! prescribed row are `-c t_i t_j`, exactly 0 for `lambda_j = 0`. [`EMPTY_COLUMN_TOLERANCE`]
+//! = 1e-12 leaves 500 times that round-off for a state a few operations off the cone, and
+//! is 100 times below the symmetric LU's relative pivot tolerance (`PIVOT_TOLERANCE` =
+//! 1e-10): a column the rule keeps has an entry the factorization can tell from round-off.
+//! A column that is small but above it (a node 1e-12 or more off the cone) keeps its own
+//! equation, whose root is `lambda_j = 0` as well.
 //!
 //! The decision is made from the operator outputs (`Evaluation::nodal`), not from the
 //! assembled matrix, so that a residual-only evaluation (line search) and the Jacobian
