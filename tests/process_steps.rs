@@ -425,8 +425,8 @@ fn the_u_channel_springs_open_once_released() {
 /// asserted) and that the strip yields again while it is unloaded.
 #[test]
 fn the_u_channel_with_kinematic_hardening_releases_and_springs_open() {
-    let (angles, unloading_work) = u_channel_springs_open(&["kinematic=true"]);
-    assert_eq!(angles["kinematic"], true, "{angles}");
+    let (summary, unloading_work) = u_channel_springs_open(&["kinematic=true"]);
+    assert_eq!(summary["hardening"], "chaboche");
     // Reverse yielding: the strip flows plastically while the tools let go (release and
     // lift-off), which an elastic unloading would not (its plastic work increments are
     // exactly zero; 1e-6 of the drawing's work is far above the round-off of a sum of 70
@@ -435,14 +435,15 @@ fn the_u_channel_with_kinematic_hardening_releases_and_springs_open() {
 }
 
 /// Runs the U-channel springback script with `sets` and checks what summary.json says of
-/// the springback; returns its `springback_angles` and the plastic work of the unloading
-/// steps (release and lift-off) relative to that of closing and drawing (history.csv).
+/// the springback (the engine's `section_angles` and `springback`); returns summary.json and
+/// the plastic work of the unloading steps (release and lift-off) relative to that of
+/// closing and drawing (history.csv).
 fn u_channel_springs_open(sets: &[&str]) -> (serde_json::Value, f64) {
     let tag = format!("{}-{}", std::process::id(), sets.len());
     let out = TestDir::new(&format!("tribo-uc-springback-{tag}"));
     run_script("scripts/u_channel_springback.rhai", &out, None, sets);
     let summary = json(&out.join("summary.json"));
-    let angles = &summary["springback_angles"];
+    let angles = &summary["section_angles"];
     let (before, after) = (
         angles["loaded"]["theta1"].as_f64().unwrap(),
         angles["released"]["theta1"].as_f64().unwrap(),
@@ -472,10 +473,10 @@ fn u_channel_springs_open(sets: &[&str]) -> (serde_json::Value, f64) {
     assert!(rms > 0.0 && rms < max, "{rms} {max}");
     let unloading_work = unloading_plastic_work(&out.join("history.csv"));
     println!(
-        "{sets:?}: springback_angles {angles}, springback {springback:?}, unloading plastic work {unloading_work:e} of the loading's"
+        "{sets:?}: section_angles {angles}, springback {springback:?}, unloading plastic work {unloading_work:e} of the loading's"
     );
     let _ = std::fs::remove_dir_all(&out);
-    (angles.clone(), unloading_work)
+    (summary, unloading_work)
 }
 
 /// The plastic dissipation of the steps after drawing (index 1) relative to that at its
