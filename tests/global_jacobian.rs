@@ -73,50 +73,15 @@ fn check(mut model: tribo::solver::Model) -> Simulation {
 /// strain the multiplier's only other entry lies in the node's y equilibrium row, a
 /// Dirichlet row, so its column was empty and the Jacobian singular (the U-channel's
 /// release with Chaboche hardening stopped there). The component gets the equation
-/// `lambda_y = 0` instead, which is the operator's own solution (`F_equi_y = 0`).
+/// `lambda_y = 0` instead, which is the operator's own solution (`F_equi_y = 0`): the
+/// empty-column rule of src/solver/assembly/unit_rows.rs.
 #[test]
-#[ignore = "issue 47: fails on main: a slipping node on the Coulomb cone with a prescribed component across its normal leaves an empty multiplier column (the fix did not land: docs/u-channel-springback.md, \"Not done\")"]
 fn a_slipping_node_on_the_cone_in_plane_strain_leaves_no_empty_column() {
     use tribo::contact::ContactStatus;
-    use tribo::geometry::Plane;
     use tribo::solver::linear::{FaerLu, LinearSolver};
-    use tribo::tool::ScalarSchedule;
-    let mesh =
-        tribo::mesh::Mesh::block(Vec3::zeros(), Vec3::new(2.0, 1.0, 1.0), [2, 1, 1]).unwrap();
-    let mut model = tribo::solver::Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
-    // A holder plane touching the top face (gap 0), its normal towards the block.
-    let holder = Plane::new(Vec3::new(0.0, 0.0, 1.0), -Vec3::z()).unwrap();
-    let path = [(0.0, [0.0; 3]), (1.0, [0.0; 3])];
-    let mu = 0.1;
-    model
-        .add_tool(common::tool("holder", holder, &path, mu), "z+", None)
-        .unwrap();
-    model
-        .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
-        .unwrap();
-    for face in ["y-", "y+"] {
-        model
-            .prescribe(face, "y", ScalarSchedule::constant(0.0))
-            .unwrap();
-    }
-    model.settings.end_time = 1.0;
-    let sim = Simulation::new(model).unwrap();
-    let n_u = 3 * sim.model.mesh.nodes.len();
-    let candidates = sim.model.contacts[0].candidates.len();
-    let mut x = sim.unknowns().to_vec();
-    assert_eq!(
-        x.len(),
-        n_u + 3 * candidates,
-        "displacements, then multipliers"
-    );
-    // Every candidate pressed with 20 and pulled along x just past mu * 20 (by a relative
-    // 1e-15: outside the cone by round-off, as a node that slipped last increment).
-    let pressed = 20.0;
-    for k in 0..candidates {
-        x[n_u + 3 * k] = -mu * pressed * (1.0 + 1e-15);
-        x[n_u + 3 * k + 2] = pressed;
-    }
-    let e = sim.evaluate_at(0.5, &x).unwrap();
+    // Pulled along x just past mu * 20 (by a relative 1e-15: outside the cone by round-off,
+    // as a node that slipped last increment).
+    let (x, n_u, candidates, e) = pressed_and_pulled(1.0 + 1e-15);
     assert!(
         e.nodal[0]
             .iter()
@@ -149,4 +114,66 @@ fn a_slipping_node_on_the_cone_in_plane_strain_leaves_no_empty_column() {
     for k in 0..candidates {
         assert_eq!(x[n_u + 3 * k + 1] + dx[n_u + 3 * k + 1], 0.0);
     }
+}
+
+/// The counterpart: pulled to twice the cone, the slip law's own row determines the y
+/// multiplier (`dF_suppl_y / dlambda_y = -(1 - mu |sigma_n| / |sigma_t|) / r = -1 / (2 r)`),
+/// and the empty-column rule leaves it alone: the diagonal entry is the operator's, not the
+/// unit row's 1.
+#[test]
+fn a_slipping_node_off_the_cone_keeps_its_own_multiplier_row() {
+    let (_, n_u, candidates, e) = pressed_and_pulled(2.0);
+    for k in 0..candidates {
+        let l = n_u + 3 * k + 1;
+        let (result, _) = &e.nodal[0][k];
+        let diagonal = e.jacobian.values[e.jacobian.pattern.position(l, l).unwrap()];
+        assert_eq!(diagonal, result.suppl_lambda[(1, 1)], "candidate {k}");
+        // -1/(2r) to round-off, r being the pair's augmentation.
+        assert!(diagonal < 0.0, "candidate {k}: {diagonal}");
+        assert_eq!(e.residual[l], result.f_suppl[1], "candidate {k}");
+    }
+}
+
+/// A 2 x 1 x 1 elastic block in plane strain (y fixed on both faces), clamped below, its top
+/// face touching a holder plane (Coulomb 0.1); every candidate's multiplier pressed with 20
+/// and pulled along x to `pull` times the cone, `mu * 20`. Returns the unknowns, the number
+/// of displacement unknowns, the candidates and the evaluation there.
+fn pressed_and_pulled(pull: f64) -> (Vec<f64>, usize, usize, tribo::solver::assembly::Evaluation) {
+    use tribo::geometry::Plane;
+    use tribo::tool::ScalarSchedule;
+    let mesh =
+        tribo::mesh::Mesh::block(Vec3::zeros(), Vec3::new(2.0, 1.0, 1.0), [2, 1, 1]).unwrap();
+    let mut model = tribo::solver::Model::new(mesh, common::elastic(1000.0, 0.3)).unwrap();
+    // A holder plane touching the top face (gap 0), its normal towards the block.
+    let holder = Plane::new(Vec3::new(0.0, 0.0, 1.0), -Vec3::z()).unwrap();
+    let path = [(0.0, [0.0; 3]), (1.0, [0.0; 3])];
+    let mu = 0.1;
+    model
+        .add_tool(common::tool("holder", holder, &path, mu), "z+", None)
+        .unwrap();
+    model
+        .prescribe("z-", "xyz", ScalarSchedule::constant(0.0))
+        .unwrap();
+    for face in ["y-", "y+"] {
+        model
+            .prescribe(face, "y", ScalarSchedule::constant(0.0))
+            .unwrap();
+    }
+    model.settings.end_time = 1.0;
+    let sim = Simulation::new(model).unwrap();
+    let n_u = 3 * sim.model.mesh.nodes.len();
+    let candidates = sim.model.contacts[0].candidates.len();
+    let mut x = sim.unknowns().to_vec();
+    assert_eq!(
+        x.len(),
+        n_u + 3 * candidates,
+        "displacements, then multipliers"
+    );
+    let pressed = 20.0;
+    for k in 0..candidates {
+        x[n_u + 3 * k] = -mu * pressed * pull;
+        x[n_u + 3 * k + 2] = pressed;
+    }
+    let e = sim.evaluate_at(0.5, &x).unwrap();
+    (x, n_u, candidates, e)
 }

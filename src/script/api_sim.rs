@@ -545,6 +545,11 @@ impl SimState {
 
     /// Adds a top-level entry to summary.json and rewrites it at once (so that an entry
     /// added after `sim.run()` lands in the file, and a name clash is reported here).
+    /// Whether this simulation writes output (summary.json among it).
+    pub(super) fn has_output(&self) -> bool {
+        self.output.is_some()
+    }
+
     pub(super) fn add_summary_entry(
         &mut self,
         key: &str,

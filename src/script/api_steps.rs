@@ -63,6 +63,10 @@ pub fn register(engine: &mut Engine) {
             compile(model, &list)
         },
     );
+    engine.register_fn(
+        "section_angles",
+        |s: &mut ScriptSim, nodes: Array| -> ScriptResult<Map> { section_angles(s, &nodes) },
+    );
     engine.register_fn("step_name", |s: &mut ScriptSim| -> ScriptResult<Dynamic> {
         let mut st = s.borrow_mut();
         let sim = st.simulation()?;
@@ -71,6 +75,38 @@ pub fn register(engine: &mut Engine) {
             None => Dynamic::UNIT,
         })
     });
+}
+
+/// `sim.section_angles(nodes)`: the section measures of the nodes (in order along the
+/// section) between the loaded shape and the committed one (solver
+/// `simulation::section_angles`), also written to summary.json as `section_angles` when the
+/// simulation writes output.
+fn section_angles(s: &mut ScriptSim, nodes: &Array) -> ScriptResult<Map> {
+    let mut list = Vec::with_capacity(nodes.len());
+    for (i, v) in nodes.iter().enumerate() {
+        match v.clone().try_cast::<i64>() {
+            Some(k) if k >= 0 => list.push(k as usize),
+            _ => {
+                return runtime_error(format!(
+                    "sim.section_angles: entry {i} of the node list is {v}, not a node index"
+                ))
+            }
+        }
+    }
+    let mut st = s.borrow_mut();
+    let measured = lift(st.simulation()?.section_angles(&list))?;
+    let json = serde_json::to_value(measured).map_err(|e| {
+        Box::new(rhai::EvalAltResult::ErrorRuntime(
+            e.to_string().into(),
+            rhai::Position::NONE,
+        ))
+    })?;
+    if st.has_output() {
+        st.add_summary_entry("section_angles", json.clone())?;
+    }
+    Ok(super::convert::from_json(&json)
+        .try_cast::<Map>()
+        .unwrap_or_default())
 }
 
 /// Reads the list and rewrites the tools' schedules and force control of `model`.

@@ -16,6 +16,7 @@ pub mod dofs;
 pub use dofs::DofMap;
 pub mod force_control;
 pub mod slots;
+pub mod unit_rows;
 
 use crate::contact::{
     alart_curnier, BernsteinLaw, ContactNodeState, FrictionUpdate, NodalContact, OperatorParams,
@@ -511,6 +512,9 @@ impl IncrementContext<'_> {
             None,
             Some(&mut jac.values),
         )?;
+        for d in unit_rows::empty_columns(model, self.dofs, self.time, self.is_fixed, &eval.nodal) {
+            unit[d] = true;
+        }
         jac.set_unit_rows(&unit);
         times.contact += t1.elapsed().as_secs_f64();
         Ok(Evaluation {
@@ -561,15 +565,15 @@ impl IncrementContext<'_> {
     }
 
     /// The multiplier components `k` of a pair whose equation becomes `lambda_k = 0`: a
-    /// sticking candidate `node` with a prescribed displacement component `k` (see
-    /// `evaluate_with`).
+    /// sticking candidate `node` with a prescribed displacement component `k`
+    /// (`unit_rows::stick_rows`; the empty columns, `unit_rows::empty_columns`, are found
+    /// once every pair is evaluated).
     fn multiplier_unit_rows<'b>(
         &'b self,
-        result: &NodalContact,
+        result: &'b NodalContact,
         node: usize,
     ) -> impl Iterator<Item = usize> + 'b {
-        let stick = result.status == crate::contact::ContactStatus::Stick;
-        (0..3).filter(move |&k| stick && self.is_fixed[3 * node + k])
+        unit_rows::stick_rows(result, node, self.is_fixed)
     }
 
     /// Adds one contact pair's blocks (operator output `result` of a candidate of
@@ -723,6 +727,10 @@ impl IncrementContext<'_> {
             Some(&mut residual),
             with_jacobian.then_some(&mut jac.values[..]),
         )?;
+        // Multiplier components the linearisation leaves free (unit_rows.rs): lambda_k = 0.
+        for d in unit_rows::empty_columns(model, self.dofs, self.time, self.is_fixed, &nodal) {
+            unit_rows.push((d, x[d]));
+        }
         times.contact += t1.elapsed().as_secs_f64();
 
         let support_forces =

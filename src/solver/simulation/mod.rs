@@ -7,6 +7,7 @@ pub mod checkpoint;
 pub mod energy;
 pub mod kinematics_check;
 pub mod release;
+pub mod section_angles;
 pub mod springback;
 pub mod step_control;
 pub mod step_end;

@@ -67,7 +67,7 @@ pub fn measures(a: &[Vec3], b: &[Vec3]) -> (f64, f64) {
 
 impl Simulation {
     /// The committed node positions.
-    fn node_positions(&self) -> Vec<Vec3> {
+    pub(super) fn node_positions(&self) -> Vec<Vec3> {
         let nodes = &self.model.mesh.nodes;
         (0..nodes.len())
             .map(|n| nodes[n] + Vec3::new(self.x[3 * n], self.x[3 * n + 1], self.x[3 * n + 2]))
