@@ -99,9 +99,8 @@ pub enum LocalSolve {
     /// and the committed state to round-off.
     Exact,
     /// Stopped earlier from a linearised prediction: forces off the exact local solution by
-    /// a bounded amount (the solid-shell: `O(δ²)`, `δ <= 1e-2` of its strain scale after one
-    /// material update, `1e-4` after more), fine for a Newton iterate, not for a converged
-    /// state (Newton does not accept one).
+    /// a bounded amount (the solid-shell: `O(δ²)`, `δ <= 1e-4` of its strain scale), fine for
+    /// a Newton iterate, not for a converged state (Newton does not accept one).
     Approximate,
 }
 

@@ -97,29 +97,6 @@
 //! 25 mm and 0.92 of the whole run's CPU, with the punch force and the draw-ins of the
 //! tight tolerance to 1e-13 wherever the increments are the same (BENCHMARKS.md).
 //!
-//! After its first material update, a call from a prediction stops already at a step of
-//! [`PREDICTED_FIRST_TOLERANCE`] (10⁻²) of the strain scale. Why that is still Newton's
-//! method: at the prediction `α_p` the first-order step makes the force
-//!
-//! ```text
-//! f = r_u(u, α_p) - K_uα δ = r_u - K_uα K_αα⁻¹ r_α,      δ = K_αα⁻¹ r_α,
-//! ```
-//!
-//! the residual of the coupled system `(r_u, r_α) = 0` condensed at `(u, α_p)`, and the
-//! stiffness is its exact condensed Jacobian there. The parameters written to the memory,
-//! `α_p - δ`, and the next call's prediction `α_p - δ - P Δu` are the Simo-Rifai update
-//! `α_{k+1} = α_k - K_αα⁻¹ (r_α + K_αu Δu)`. So the global iterates are those of Newton's
-//! method on the coupled system in `(u, α)` with its exact Jacobian, quadratically
-//! convergent like the exactly condensed one (the two differ by `O(δ²)` in the force, and
-//! `δ` is itself of second order in the last step). The bound keeps the scheme to where the
-//! linearisation is good: without it (every predicted call one update) the cup took 4 % more
-//! iterations and four times the line-search trials, the force of a far prediction being a
-//! poor merit. Convergence is accepted only at exact calls, whose step `δ = K_αα⁻¹ r_α` is at
-//! most 10⁻⁸ of the scale: the converged states are unchanged. Measured on the 25 x 25 x 1 benchmark cup (counts of
-//! [`super::solid_shell_counts`], `evaluations.solid_shell_local` in summary.json): 1.026
-//! material updates per element call against 1.143, the same increments and cut-backs (494
-//! Newton iterations against 497), draw-ins and punch force equal to 1e-11.
-//!
 //! # Integration and cost
 //!
 //! 2 x 2 Gauss points in plane (full: no hourglass modes) times `n` points through the
@@ -193,22 +170,6 @@ const LOCAL_TOLERANCE: f64 = 1e-8;
 /// only on exact calls, so the converged states are those of [`LOCAL_TOLERANCE`]; the
 /// iterates before take fewer material updates (module docs, "Local solve").
 const PREDICTED_LOCAL_TOLERANCE: f64 = 1e-4;
-
-/// A local iteration started from the linearised prediction stops after its first
-/// material update already where that update's step is at most this fraction of the strain
-/// scale, taken to first order. The force is then the condensed residual of the coupled
-/// system `(u, α)` at the prediction, `r_u - K_uα K_αα⁻¹ r_α`, and the parameters the next
-/// call predicts from are those of the Simo-Rifai update: the global iteration is Newton's
-/// method on the coupled system, its quadratic convergence kept (module docs, "Local
-/// solve"). The force is within about `(δ / scale)² ≤ 10⁻⁴` relative of the exact local
-/// solution's, and the call reports [`LocalSolve::Approximate`]. On the 25 x 25 x 1
-/// benchmark cup it takes the material updates per call from 1.143 to 1.026 with the same
-/// increments (1e-1: 1.008, a different step sequence past 30 mm; without a
-/// bound, 1.005 per call but 4 % more iterations and four times the line-search trials:
-/// a far prediction's linearised force is a poor merit). Later updates keep
-/// [`PREDICTED_LOCAL_TOLERANCE`] (raising it for every update added iterations and
-/// cut-backs, docs/history/benchmarks.md).
-const PREDICTED_FIRST_TOLERANCE: f64 = 1e-2;
 
 /// The least strain scale of [`LOCAL_TOLERANCE`]: the round-off of a unit stretch. At an
 /// unstrained element (scale 0) started a round-off away from its parameters' solution 0
@@ -927,7 +888,7 @@ impl SolidShell {
         material: &dyn Material,
         strain_scale: f64,
         damped: bool,
-        (max_steps, tolerance, first_tolerance): (usize, f64, f64),
+        (max_steps, tolerance): (usize, f64),
         alpha: &mut Modes,
         stresses: &mut [Voigt],
         tangents: &mut [Tangent],
@@ -979,7 +940,6 @@ impl SolidShell {
             let size = step.amax();
             let scale = strain_scale.max(alpha.amax()).max(STRAIN_ROUND_OFF);
             tally.first_step.get_or_insert(size / scale);
-            let tolerance = if newton_steps == 0 { first_tolerance } else { tolerance };
             if size <= tolerance * scale {
                 let solve = if size <= LOCAL_TOLERANCE * scale {
                     LocalSolve::Exact
@@ -1187,7 +1147,7 @@ impl Element<DOFS> for SolidShell {
         let mut stresses = [Voigt::zeros(); 4 * MAX_THICKNESS_POINTS];
         let mut tangents = [Tangent::zeros(); 4 * MAX_THICKNESS_POINTS];
         let mut tally = Tally::default();
-        let mut local = |damped: bool, limits: (usize, f64, f64), alpha: &mut Modes| {
+        let mut local = |damped: bool, limits: (usize, f64), alpha: &mut Modes| {
             self.solve_enhanced_parameters(
                 &points,
                 committed,
@@ -1205,14 +1165,10 @@ impl Element<DOFS> for SolidShell {
         // Full steps from the prediction, then from the remembered (or given) start, then
         // halved ones from there (doc of `solve_enhanced_parameters`).
         let mut alpha = predicted.unwrap_or(unpredicted);
-        let predicted_limits = (
-            PREDICTED_LOCAL_ITERATIONS,
-            PREDICTED_LOCAL_TOLERANCE,
-            PREDICTED_FIRST_TOLERANCE,
-        );
+        let predicted_limits = (PREDICTED_LOCAL_ITERATIONS, PREDICTED_LOCAL_TOLERANCE);
         let from_prediction =
             predicted.and_then(|_| local(false, predicted_limits, &mut alpha).ok());
-        let limits = (MAX_LOCAL_ITERATIONS, LOCAL_TOLERANCE, LOCAL_TOLERANCE);
+        let limits = (MAX_LOCAL_ITERATIONS, LOCAL_TOLERANCE);
         let with_stiffness = stiffness.is_some();
         let (outcome, kind) = match from_prediction {
             Some(done) => (Ok(done), CallKind::Predicted),
@@ -1233,7 +1189,11 @@ impl Element<DOFS> for SolidShell {
                 }
             }
         };
-        let kind = if outcome.is_ok() { kind } else { CallKind::Failed };
+        let kind = if outcome.is_ok() {
+            kind
+        } else {
+            CallKind::Failed
+        };
         let first_step = predicted.and(tally.first_step);
         counts::record(kind, with_stiffness, tally.updates, first_step);
         let (delta, solve) = outcome?;
