@@ -23,6 +23,7 @@ pub mod hex8_fbar;
 #[doc(hidden)]
 pub mod hex8_fbar_reference;
 pub mod solid_shell;
+pub mod solid_shell_counts;
 #[doc(hidden)]
 pub mod solid_shell_reference;
 

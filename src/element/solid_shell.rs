@@ -108,6 +108,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::hex8::{jacobian, nodes_array, response_through_into, shape_derivatives, DOFS, NODES};
+use super::solid_shell_counts::{self as counts, CallKind};
 use super::{prefix, Element, ElementResponse, LocalSolve};
 use crate::geometry::{Mat3, Vec3};
 use crate::material::{
@@ -557,6 +558,15 @@ pub(super) fn cauchy_stress(f: &Mat3, e: &Voigt, s: &Voigt) -> Result<Voigt> {
     ))
 }
 
+/// What one element call's local solve did, for [`counts`]: material updates of all its
+/// points (local iterations, halved retries included) and its first step over the strain
+/// scale.
+#[derive(Default)]
+struct Tally {
+    updates: usize,
+    first_step: Option<f64>,
+}
+
 /// Columns of the combined operator `[B | M]` of a point: its displacements' and its
 /// enhanced parameters' strains.
 const WIDE: usize = DOFS + ENHANCED_PARAMETERS;
@@ -882,6 +892,7 @@ impl SolidShell {
         alpha: &mut Modes,
         stresses: &mut [Voigt],
         tangents: &mut [Tangent],
+        tally: &mut Tally,
     ) -> Result<(Modes, LocalSolve)> {
         let ne = self.modes();
         // The last Newton step taken: the parameters it started from, the step, the
@@ -892,6 +903,7 @@ impl SolidShell {
             let mut r_a = Modes::zeros();
             let mut k_aa = SMatrix::<f64, ENHANCED_PARAMETERS, ENHANCED_PARAMETERS>::zeros();
             let mut failed = None;
+            tally.updates += 1;
             for (p, point) in points.iter().enumerate() {
                 match self.material_at(point, alpha, &committed[p], &mut trial[p], material) {
                     Ok((s, c)) => {
@@ -921,11 +933,13 @@ impl SolidShell {
                 }
             }
             if let Some(e) = failed {
+                tally.first_step.get_or_insert(f64::INFINITY);
                 return Err(e);
             }
             let step = solve_enhanced(k_aa, ne, &r_a)?;
             let size = step.amax();
             let scale = strain_scale.max(alpha.amax()).max(STRAIN_ROUND_OFF);
+            tally.first_step.get_or_insert(size / scale);
             if size <= tolerance * scale {
                 let solve = if size <= LOCAL_TOLERANCE * scale {
                     LocalSolve::Exact
@@ -1132,6 +1146,7 @@ impl Element<DOFS> for SolidShell {
         let np = points.len();
         let mut stresses = [Voigt::zeros(); 4 * MAX_THICKNESS_POINTS];
         let mut tangents = [Tangent::zeros(); 4 * MAX_THICKNESS_POINTS];
+        let mut tally = Tally::default();
         let mut local = |damped: bool, limits: (usize, f64), alpha: &mut Modes| {
             self.solve_enhanced_parameters(
                 &points,
@@ -1144,6 +1159,7 @@ impl Element<DOFS> for SolidShell {
                 alpha,
                 &mut stresses,
                 &mut tangents,
+                &mut tally,
             )
         };
         // Full steps from the prediction, then from the remembered (or given) start, then
@@ -1153,19 +1169,34 @@ impl Element<DOFS> for SolidShell {
         let from_prediction =
             predicted.and_then(|_| local(false, predicted_limits, &mut alpha).ok());
         let limits = (MAX_LOCAL_ITERATIONS, LOCAL_TOLERANCE);
-        let (delta, solve) = match from_prediction {
-            Some(done) => done,
+        let with_stiffness = stiffness.is_some();
+        let (outcome, kind) = match from_prediction {
+            Some(done) => (Ok(done), CallKind::Predicted),
             None => {
+                let restart = if predicted.is_some() {
+                    CallKind::Restarted
+                } else {
+                    CallKind::Cold
+                };
                 alpha = unpredicted;
                 match local(false, limits, &mut alpha) {
-                    Ok(done) => done,
+                    Ok(done) => (Ok(done), restart),
                     Err(full_steps) => {
                         alpha = unpredicted;
-                        local(true, limits, &mut alpha).map_err(|_| full_steps)?
+                        let halved = local(true, limits, &mut alpha).map_err(|_| full_steps);
+                        (halved, CallKind::Halved)
                     }
                 }
             }
         };
+        let kind = if outcome.is_ok() {
+            kind
+        } else {
+            CallKind::Failed
+        };
+        let first_step = predicted.and(tally.first_step);
+        counts::record(kind, with_stiffness, tally.updates, first_step);
+        let (delta, solve) = outcome?;
         // The last step to first order: `α - δ`, `S - ℂ M δ` (LOCAL_TOLERANCE).
         for ((point, s), c) in points.iter().zip(&mut stresses).zip(&tangents) {
             *s -= c * (point.modes * delta);

@@ -119,6 +119,9 @@ pub struct RunOutput {
     /// `phase_times_s.frames` and `.tool_frames`), so that a run says what its output cost.
     frame_seconds: f64,
     tool_frame_seconds: f64,
+    /// The solid-shell's local-solve counts when this output began: summary.json reports
+    /// this process's calls since ([`crate::element::solid_shell_counts`]).
+    local_counts: crate::element::solid_shell_counts::Counts,
 }
 
 impl RunOutput {
@@ -207,6 +210,7 @@ impl RunOutput {
             field_samples: Vec::new(),
             frame_seconds: 0.0,
             tool_frame_seconds: 0.0,
+            local_counts: crate::element::solid_shell_counts::snapshot(),
         })
     }
 
@@ -571,6 +575,7 @@ impl RunOutput {
                 "residual_only": sim.phase_times.residual_evaluations,
                 "jacobian_completions": sim.phase_times.jacobian_completions,
                 "with_approximate_local_solves": sim.phase_times.approximate_evaluations,
+                "solid_shell_local": local_counts_json(&self.local_counts),
             },
             "kinematics": settings.kinematics.name(),
             "settings": super::run_settings::settings_json(settings),
@@ -697,6 +702,41 @@ fn stale_temporary_pid(name: &str) -> Option<u32> {
         return None;
     }
     pid.parse().ok()
+}
+
+/// The solid-shell's local solves since `start` (`evaluations.solid_shell_local` of
+/// summary.json; null without a solid-shell call): calls and material updates of all a
+/// call's points per kind of call, each as `[residual-only, with stiffness]`, their ratio,
+/// and the histograms of [`crate::element::solid_shell_counts`].
+fn local_counts_json(start: &crate::element::solid_shell_counts::Counts) -> serde_json::Value {
+    use crate::element::solid_shell_counts::{snapshot, KINDS, STEP_DECADES};
+    let c = snapshot().since(start);
+    let calls = c.total_calls();
+    if calls == 0 {
+        return serde_json::Value::Null;
+    }
+    let per_kind = |v: &[[u64; 2]; KINDS.len()]| -> serde_json::Map<String, serde_json::Value> {
+        KINDS
+            .iter()
+            .zip(v)
+            .map(|((_, name), n)| (name.to_string(), serde_json::json!(n)))
+            .collect()
+    };
+    let decades: Vec<String> = STEP_DECADES
+        .iter()
+        .map(|d| format!("<= {d:e}"))
+        .chain(["larger".to_string()])
+        .collect();
+    serde_json::json!({
+        "calls": calls,
+        "material_updates": c.total_updates(),
+        "updates_per_call": c.total_updates() as f64 / calls as f64,
+        "calls_by_kind": per_kind(&c.calls),
+        "updates_by_kind": per_kind(&c.updates),
+        "predicted_calls_by_updates": c.predicted_updates,
+        "first_step_decades": decades,
+        "predicted_first_step": c.first_step,
+    })
 }
 
 #[cfg(test)]
