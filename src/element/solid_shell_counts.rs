@@ -77,13 +77,27 @@ impl Counts {
     /// `self - earlier`, entry by entry.
     pub fn since(&self, earlier: &Counts) -> Counts {
         let mut out = *self;
-        for (o, e) in out.calls.iter_mut().flatten().zip(earlier.calls.iter().flatten()) {
+        for (o, e) in out
+            .calls
+            .iter_mut()
+            .flatten()
+            .zip(earlier.calls.iter().flatten())
+        {
             *o -= e;
         }
-        for (o, e) in out.updates.iter_mut().flatten().zip(earlier.updates.iter().flatten()) {
+        for (o, e) in out
+            .updates
+            .iter_mut()
+            .flatten()
+            .zip(earlier.updates.iter().flatten())
+        {
             *o -= e;
         }
-        for (o, e) in out.predicted_updates.iter_mut().zip(&earlier.predicted_updates) {
+        for (o, e) in out
+            .predicted_updates
+            .iter_mut()
+            .zip(&earlier.predicted_updates)
+        {
             *o -= e;
         }
         for (o, e) in out.first_step.iter_mut().zip(&earlier.first_step) {
